@@ -1,0 +1,80 @@
+"""Shared plumbing of the command line: stderr console, JSON on stdout, exit codes.
+
+Contract (INTERFACES.md): ``--json`` prints exactly one JSON document on stdout,
+progress and logs go to stderr; exit code 0 ok, 1 failed, 2 bad input.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+
+err = Console(stderr=True)
+
+
+class BadInput(ValueError):
+    """A user-supplied input (file, option, value) is invalid: exit code 2."""
+
+
+def _plain(obj: Any) -> Any:
+    if isinstance(obj, dict):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _plain(obj.tolist())
+    if isinstance(obj, np.generic):
+        return _plain(obj.item())
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None  # JSON has no NaN/inf
+    if hasattr(obj, "__fspath__"):
+        return str(obj)
+    return obj
+
+
+def emit_json(doc: dict[str, Any]) -> None:
+    """Print one JSON document on stdout (NaN/inf become null)."""
+    sys.stdout.write(json.dumps(_plain(doc), indent=2) + "\n")
+    sys.stdout.flush()
+
+
+@contextmanager
+def exit_codes() -> Iterator[None]:
+    """Map exceptions to the exit-code contract with a one-line message on stderr."""
+    try:
+        yield
+    except typer.Exit:
+        raise
+    except (BadInput, ValueError, FileNotFoundError) as exc:
+        err.print(f"[bold red]error:[/] {exc}")
+        raise typer.Exit(EXIT_BAD_INPUT) from None
+    except KeyboardInterrupt:
+        err.print("[yellow]interrupted[/]")
+        raise typer.Exit(130) from None
+    except Exception as exc:  # any other failure is ours, not the user's input
+        err.print(f"[bold red]failed:[/] {type(exc).__name__}: {exc}")
+        raise typer.Exit(EXIT_FAILED) from None
+
+
+def progress_bar() -> Progress:
+    """A progress bar on stderr (silent when stderr is not a terminal)."""
+    return Progress(
+        TextColumn("[progress.description]{task.description}"),
+        BarColumn(),
+        TextColumn("{task.completed}/{task.total}"),
+        TimeElapsedColumn(),
+        TimeRemainingColumn(),
+        console=err,
+        transient=True,
+    )

@@ -1,0 +1,6 @@
+"""Estimation filters of the source papers (ALGORITHMS.md §1–§3, §5)."""
+
+from seawatch.filters.kalman import KalmanFilter
+from seawatch.filters.result import FilterResult
+
+__all__ = ["FilterResult", "KalmanFilter"]
