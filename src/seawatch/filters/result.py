@@ -23,7 +23,8 @@ class FilterResult:
         covariances: posterior covariances P_{k|k}, shape (B..., T, n, n).
         predicted_states: priors x_{k|k-1}, shape (B..., T, n).
         predicted_covariances: prior covariances P_{k|k-1}, shape (B..., T, n, n).
-        innovations: z_k - H x_{k|k-1}, shape (B..., T, m).
+        innovations: z_k - h(x_{k|k-1}) (z_k - H x_{k|k-1} for linear models; angular
+            components wrapped to (-pi, pi]), shape (B..., T, m).
         innovation_covariances: S_k = H P_{k|k-1} H^T + R, shape (B..., T, m, m).
         nis: normalised innovation squared y^T S^-1 y (dimensionless, chi-square with m
             degrees of freedom for a consistent filter), shape (B..., T).
