@@ -1,0 +1,59 @@
+"""The command-line contract (INTERFACES.md): --version, --help with an example, one JSON
+document on stdout with --json, exit codes 0 / 1 / 2."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+import typer
+from typer.testing import CliRunner
+
+from seawatch import __version__
+from seawatch.cli import app
+
+runner = CliRunner()
+
+
+def test_version_prints_the_installed_version():
+    result = runner.invoke(app, ["--version"])
+    assert result.exit_code == 0
+    assert __version__ in result.stdout
+
+
+COMMANDS = sorted(typer.main.get_command(app).commands)  # type: ignore[attr-defined]
+
+
+def test_the_commands_of_this_stage_exist():
+    assert {"demo", "bench"} <= set(COMMANDS)
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_every_sub_command_help_shows_an_example(command):
+    result = runner.invoke(app, [command, "--help"])
+    assert result.exit_code == 0
+    assert "Example" in result.stdout and f"seawatch {command}" in result.stdout
+
+
+def test_bench_filters_json_is_one_document_with_ratios_and_agreement():
+    result = runner.invoke(
+        app, ["bench", "filters", "--steps", "2000", "--tracks", "100", "--repeats", "1", "--json"]
+    )
+    assert result.exit_code == 0, result.output
+    doc = json.loads(result.stdout)
+    assert doc["benchmark"] == "filters"
+    names = {r["name"] for r in doc["results"]}
+    assert names >= {"seawatch.filter", "seawatch.step", "filterpy.KalmanFilter", "numpy.loop"}
+    assert doc["ratios"]["seawatch.filter/filterpy.KalmanFilter"] > 0
+    assert doc["agreement"]["max_rel_diff"] <= 1e-9 and doc["agreement"]["ok"]
+
+
+def test_unknown_benchmark_is_bad_input_exit_2():
+    result = runner.invoke(app, ["bench", "warp-drive"])
+    assert result.exit_code == 2
+    assert "warp-drive" in result.output
+
+
+def test_unknown_option_is_a_usage_error_exit_2():
+    result = runner.invoke(app, ["bench", "filters", "--no-such-option"])
+    assert result.exit_code == 2
