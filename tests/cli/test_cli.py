@@ -57,3 +57,15 @@ def test_unknown_benchmark_is_bad_input_exit_2():
 def test_unknown_option_is_a_usage_error_exit_2():
     result = runner.invoke(app, ["bench", "filters", "--no-such-option"])
     assert result.exit_code == 2
+
+
+def test_demo_json_lists_outputs_that_exist_and_records_of_every_filter(tmp_path):
+    result = runner.invoke(app, ["demo", "--out", str(tmp_path), "--runs", "3", "--json"])
+    assert result.exit_code == 0, result.output
+    doc = json.loads(result.stdout)
+    assert doc["scenario"] == "air-range" and doc["runs"] == 3
+    for path in doc["outputs"]:
+        assert (tmp_path / path.rsplit("/", 1)[-1]).stat().st_size > 0
+    estimators = {r["estimator"] for r in doc["results"]}
+    assert {"raw", "ncv-1", "nca-0.1", "ancv", "anca"} <= estimators
+    assert all(r["unit"] == "m" and r["mean"] > 0 for r in doc["results"])

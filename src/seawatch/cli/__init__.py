@@ -75,17 +75,28 @@ def demo(
                 seed=seed,
                 progress=lambda done, total: bar.update(task, completed=done),
             )
+        outputs = [str(result.table_path), str(result.plot_path)]
         if json_out:
-            emit_json(result.to_json())
+            emit_json(
+                {
+                    "scenario": "air-range",
+                    "runs": runs,
+                    "seed": seed,
+                    "results": result.records,
+                    "outputs": outputs,
+                }
+            )
             return
-        table = Table(title=f"air-range: RMS range error over {runs} runs (seed {seed})")
+        metrics = air_range.METRICS
+        table = Table(title=f"air-range: RMS range error (m) over {runs} runs (seed {seed})")
         table.add_column("filter")
-        for metric in result.metrics:
+        for metric in metrics:
             table.add_column(metric, justify="right")
-        for estimator, values in result.table().items():
-            table.add_row(estimator, *(f"{values[m]:.2f}" for m in result.metrics))
+        for row in result.rows:
+            cells = (f"{row[f'{m}_m']:.2f} ± {row[f'{m}_stderr_m']:.2f}" for m in metrics)
+            table.add_row(row["estimator"], *cells)
         err.print(table)
-        for path in result.outputs:
+        for path in outputs:
             typer.echo(f"wrote {path}")
 
 
