@@ -1,6 +1,7 @@
 """Estimation filters of the source papers (ALGORITHMS.md §1–§3, §5)."""
 
 from seawatch.filters.adaptive_range import AdaptiveRangeFilter
+from seawatch.filters.diffuse_rls import DiffuseRLS, DiffuseRLSResult, SlidingWindowDiffuseRLS
 from seawatch.filters.fractional import (
     AdaptiveFractionalKalmanFilter,
     FractionalKalmanFilter,
@@ -15,10 +16,13 @@ from seawatch.filters.strong_tracking import StrongTrackingKalmanFilter, StrongT
 __all__ = [
     "AdaptiveFractionalKalmanFilter",
     "AdaptiveRangeFilter",
+    "DiffuseRLS",
+    "DiffuseRLSResult",
     "ExtendedKalmanFilter",
     "FilterResult",
     "FractionalKalmanFilter",
     "KalmanFilter",
+    "SlidingWindowDiffuseRLS",
     "StrongTrackingKalmanFilter",
     "StrongTrackingResult",
     "UnscentedKalmanFilter",
