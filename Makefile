@@ -12,13 +12,21 @@ $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 
+# TrackEval (CLEAR-MOT, IDF1, HOTA) is installed without its declared dependencies:
+# they pull in opencv-python (the GUI build, which clashes with opencv-python-headless
+# over the cv2 module) and pycocotools, neither needed by the metric classes we use
+# (../shared/spec/DEPENDENCIES.md).
+TRACKEVAL := trackeval==1.3.0 tabulate
+
 # Stamps: reinstall only when pyproject.toml changes.
 $(VENV)/.installed-base: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install --quiet -e .
+	$(BIN)/pip install --quiet --no-deps $(TRACKEVAL)
 	touch $@
 
 $(VENV)/.installed-test: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install --quiet -e '.[test]'
+	$(BIN)/pip install --quiet --no-deps $(TRACKEVAL)
 	touch $@ $(VENV)/.installed-base
 
 demo: $(VENV)/.installed-base
