@@ -69,3 +69,24 @@ def test_demo_json_lists_outputs_that_exist_and_records_of_every_filter(tmp_path
     estimators = {r["estimator"] for r in doc["results"]}
     assert {"raw", "ncv-1", "nca-0.1", "ancv", "anca"} <= estimators
     assert all(r["unit"] == "m" and r["mean"] > 0 for r in doc["results"])
+
+
+def test_experiment_json_has_the_interfaces_shape(tmp_path):
+    result = runner.invoke(
+        app,
+        ["experiment", "air-range", "--runs", "2", "--seed", "4", "--out", str(tmp_path), "--json"],
+    )
+    assert result.exit_code == 0, result.output
+    doc = json.loads(result.stdout)
+    assert (doc["scenario"], doc["runs"], doc["seed"]) == ("air-range", 2, 4)
+    keys = {"estimator", "metric", "unit", "mean", "stderr", "paper", "params"}
+    assert all(keys <= set(r) for r in doc["results"])
+    assert len(doc["outputs"]) == 2
+
+
+@pytest.mark.parametrize(
+    "args", [["experiment", "no-such-paper"], ["experiment", "air-range", "--table", "2"]]
+)
+def test_experiment_bad_name_or_option_is_exit_2(args):
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2

@@ -101,6 +101,69 @@ def demo(
 
 
 @app.command()
+def experiment(
+    name: Annotated[str, typer.Argument(help="Experiment name, e.g. air-range, clutter-tbd.")],
+    runs: Annotated[
+        int | None, typer.Option(help="Monte-Carlo runs (scenario default if omitted).", min=1)
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", help="Folder for CSV tables and PNG plots.")
+    ] = None,
+    table: Annotated[
+        str | None, typer.Option(help="clutter-tbd: which table to reproduce (1, 2, fig4, all).")
+    ] = None,
+    json_out: Annotated[bool, typer.Option("--json", help="Print the experiment JSON.")] = False,
+) -> None:
+    """Run one of the papers' experiments by name and compare with the paper.
+
+    Prints a table of every estimator and metric (mean ± standard error over runs, and
+    the paper's value where it gives one); ``--json`` prints the experiment JSON of
+    INTERFACES.md; ``--out`` writes CSV tables and PNG plots as they are produced.
+
+    Example: [cyan]seawatch experiment air-range --runs 100 --out out/air-range[/]
+    """
+    from seawatch.scenarios import registry
+
+    with exit_codes():
+        run = registry.runner(name)
+        kwargs: dict[str, object] = {"seed": seed, "out_dir": out}
+        if runs is not None:
+            kwargs["runs"] = runs
+        if table is not None:
+            if "table" not in registry.options(name):
+                raise BadInput(f"--table: experiment {name!r} has no tables to choose from")
+            kwargs["table"] = table
+        with progress_bar() as bar:
+            task = bar.add_task(name, total=None)
+            result = run(
+                progress=lambda done, total: bar.update(task, completed=done, total=total),
+                **kwargs,
+            )
+        if json_out:
+            emit_json(result.to_json())
+            return
+        view = Table(title=f"{name}: {result.runs} runs, seed {result.seed}")
+        for col in ("estimator", "metric", "params", "mean ± stderr", "unit", "paper"):
+            view.add_column(col, justify="right" if col in ("mean ± stderr", "paper") else "left")
+        for rec in result.results:
+            se = "" if rec["stderr"] is None else f" ± {rec['stderr']:.3g}"
+            params = ", ".join(f"{k}={v}" for k, v in rec["params"].items())
+            paper = "" if rec["paper"] is None else f"{rec['paper']:g}"
+            view.add_row(
+                rec["estimator"],
+                rec["metric"],
+                params,
+                f"{rec['mean']:.4g}{se}",
+                rec["unit"],
+                paper,
+            )
+        err.print(view)
+        for path in result.outputs:
+            typer.echo(f"wrote {path}")
+
+
+@app.command()
 def bench(
     name: Annotated[str, typer.Argument(help=f"Benchmark name: {', '.join(BENCHMARKS)}.")],
     steps: Annotated[

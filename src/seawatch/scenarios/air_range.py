@@ -68,6 +68,7 @@ from seawatch.filters.adaptive_range import (
     AdaptiveRangeFilter,
     size_range_std,
 )
+from seawatch.scenarios.base import ExperimentResult
 
 SCENARIO = "air-range"
 FOCAL_PX = 40_000.0
@@ -531,3 +532,19 @@ def _check_runs(runs: int) -> int:
     if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
         raise ValueError(f"runs: expected an integer >= 1, got {runs!r}")
     return int(runs)
+
+
+def experiment(
+    runs: int = 100,
+    seed: int = 0,
+    out_dir: Path | None = None,
+    progress: ProgressCallback | None = None,
+) -> ExperimentResult:
+    """``seawatch experiment air-range``: :func:`run`, plus ``errors.csv`` and
+    ``range_error.png`` in ``out_dir`` when one is given."""
+    if out_dir is None:
+        return ExperimentResult("air-range", runs, seed, run(runs, seed, progress).records)
+    demo = run_demo(out_dir, runs=runs, seed=seed, progress=progress)
+    return ExperimentResult(
+        "air-range", runs, seed, demo.records, outputs=[demo.table_path, demo.plot_path]
+    )
