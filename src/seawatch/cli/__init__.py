@@ -170,9 +170,7 @@ def bench(
         int, typer.Option(help="Steps of the single-track problem.", min=100)
     ] = 100_000,
     tracks: Annotated[int, typer.Option(help="Tracks of the batched problem.", min=1)] = 10_000,
-    repeats: Annotated[
-        int, typer.Option(help="Timing repeats (best of) for fast variants.", min=1)
-    ] = 3,
+    repeats: Annotated[int, typer.Option(help="Timing repeats (best of, interleaved).", min=1)] = 3,
     json_out: Annotated[
         bool, typer.Option("--json", help="Print the benchmark JSON on stdout.")
     ] = False,
@@ -192,7 +190,7 @@ def bench(
         from seawatch.bench import filters as bench_filters
 
         with progress_bar() as bar:
-            task = bar.add_task("bench filters", total=5)
+            task = bar.add_task("bench filters", total=4 * repeats + 1)
 
             def step(label: str) -> None:
                 bar.update(task, description=f"bench filters: {label}", advance=1)

@@ -36,7 +36,7 @@ def _sel(i: int, count: int) -> int:
     return i if count > 1 else 0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _predict_one(F, Q, x, P, xp, Pp, FP):
     """x_{k|k-1} = F x, P_{k|k-1} = F P F^T + Q (symmetrised)."""
     n = N_STATE if N_STATE > 0 else x.shape[0]
@@ -61,7 +61,7 @@ def _predict_one(F, Q, x, P, xp, Pp, FP):
             Pp[j, i] = v
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _update_one(H, R, z, x, P, xo, Po, y, S, PHt, L, K, A, AP, w):
     """Kalman update with the Joseph-form covariance; returns (code, nis).
 
@@ -122,25 +122,27 @@ def _update_one(H, R, z, x, P, xo, Po, y, S, PHt, L, K, A, AP, w):
         for k in range(n):
             acc -= H[i, k] * x[k]
         y[i] = acc
-    # K = PHt S^-1: solve L L^T K_i^T = PHt_i^T for each row i
+    # K = PHt S^-1: solve L L^T K_i^T = PHt_i^T for each row i (w: 1 / diag L)
+    for i in range(m):
+        w[i] = 1.0 / L[i, i]
     for r in range(n):
         for i in range(m):  # forward substitution
             acc = PHt[r, i]
             for k in range(i):
                 acc -= L[i, k] * K[r, k]
-            K[r, i] = acc / L[i, i]
+            K[r, i] = acc * w[i]
         for i in range(m - 1, -1, -1):  # back substitution
             acc = K[r, i]
             for k in range(i + 1, m):
                 acc -= L[k, i] * K[r, k]
-            K[r, i] = acc / L[i, i]
-    # nis = |L^-1 y|^2 (y^T S^-1 y)
+            K[r, i] = acc * w[i]
+    # nis = |L^-1 y|^2 (y^T S^-1 y); the forward substitution overwrites w in place
     nis = 0.0
     for i in range(m):
         acc = y[i]
         for k in range(i):
             acc -= L[i, k] * w[k]
-        w[i] = acc / L[i, i]
+        w[i] = acc * w[i]
         nis += w[i] * w[i]
     # state update
     for i in range(n):
