@@ -81,7 +81,7 @@ def test_camera_with_pitch_minus_5_deg_sees_the_true_horizon_5_deg_above_centre(
 
 # ---------------------------------------------------------------- dip (§4.2)
 def test_horizon_dip_is_arccos_re_over_re_plus_h_and_matches_the_spec_examples():
-    h = np.array([0.0, 2.0, 5.0, 10.0, 100.0, 1000.0])
+    h = np.array([0.5, 2.0, 5.0, 10.0, 100.0, 1000.0])
     re = R_EARTH / (1 - 0.14)
     np.testing.assert_allclose(horizon_dip(h), np.arccos(re / (re + h)), rtol=1e-7, atol=1e-12)
     assert math.degrees(horizon_dip(5.0)) == pytest.approx(0.0666, abs=5e-5)  # §4.2 example

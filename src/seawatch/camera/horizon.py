@@ -46,29 +46,13 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from seawatch._validation import FloatArray, as_float_array, in_range, positive
+from seawatch._validation import FloatArray, as_float_array, positive
 from seawatch.camera.attitude import R_BC
 from seawatch.camera.pinhole import PinholeCamera
-from seawatch.models.angles import EARTH_RADIUS, wrap_angle
+from seawatch.geometry.sea import horizon_dip
+from seawatch.models.angles import wrap_angle
 
 LineForm = Literal["auto", "points", "rho_theta"]
-
-
-def horizon_dip(
-    height: ArrayLike, refraction: float = 0.14, earth_radius: float = EARTH_RADIUS
-) -> FloatArray:
-    """Dip of the visible sea horizon below the true horizontal [rad] (ALGORITHMS.md §4.2).
-
-    ``dip = arccos(R_e / (R_e + h)) = atan(sqrt(2 R_e h + h^2) / R_e)`` with
-    ``R_e = R / (1 - k)``; ``height`` h [m] ≥ 0 (array), ``refraction`` k in [0, 1),
-    ``earth_radius`` R [m]. Example: h = 5 m, k = 0.14 → 0.0666°.
-    """
-    h = as_float_array("height", height)
-    if not np.all(np.isfinite(h)) or np.any(h < 0.0):
-        raise ValueError(f"height: expected camera heights >= 0 m, got {height!r}")
-    k = in_range("refraction", refraction, 0.0, 1.0, hi_open=True)
-    r_e = positive("earth_radius", earth_radius) / (1.0 - k)
-    return np.arctan2(np.sqrt(h * (2.0 * r_e + h)), r_e)
 
 
 @dataclass(frozen=True, eq=False)

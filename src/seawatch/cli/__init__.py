@@ -14,6 +14,7 @@ import typer
 from rich.table import Table
 
 from seawatch import __version__
+from seawatch.cli import geometry_cmds
 from seawatch.cli._common import EXIT_FAILED, BadInput, emit_json, err, exit_codes, progress_bar
 
 app = typer.Typer(
@@ -217,6 +218,11 @@ def bench(
         if not doc["agreement"]["ok"]:
             err.print("[bold red]failed:[/] states disagree with FilterPy beyond 1e-9 relative")
             raise typer.Exit(EXIT_FAILED)
+
+
+app.command()(geometry_cmds.locate)
+app.command()(geometry_cmds.stereo)
+app.command()(geometry_cmds.calibrate)
 
 
 def main() -> None:

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
@@ -57,13 +58,13 @@ def exit_codes() -> Iterator[None]:
     except typer.Exit:
         raise
     except (BadInput, ValueError, FileNotFoundError) as exc:
-        err.print(f"[bold red]error:[/] {exc}")
+        err.print(f"[bold red]error:[/] {escape(str(exc))}")
         raise typer.Exit(EXIT_BAD_INPUT) from None
     except KeyboardInterrupt:
         err.print("[yellow]interrupted[/]")
         raise typer.Exit(130) from None
     except Exception as exc:  # any other failure is ours, not the user's input
-        err.print(f"[bold red]failed:[/] {type(exc).__name__}: {exc}")
+        err.print(f"[bold red]failed:[/] {type(exc).__name__}: {escape(str(exc))}")
         raise typer.Exit(EXIT_FAILED) from None
 
 

@@ -25,8 +25,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from seawatch._validation import FloatArray, as_float_array, finite, in_range, matrix
+from seawatch.geometry.sea import EARTH_RADIUS
 
-EARTH_RADIUS = 6_371_000.0
 """Mean earth radius R [m] (ALGORITHMS.md §4.2)."""
 
 
