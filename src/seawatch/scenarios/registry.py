@@ -18,6 +18,10 @@ from seawatch.scenarios.base import ExperimentResult
 SCENARIOS: dict[str, tuple[str, str]] = {
     "air-range": ("seawatch.scenarios.air_range", "experiment"),
     "clutter-tbd": ("seawatch.scenarios.clutter_tbd", "run"),
+    "uav-sea": ("seawatch.scenarios.uav_sea", "run"),
+    "stereo-ferry": ("seawatch.scenarios.stereo_ferry", "run"),
+    "ship-video": ("seawatch.scenarios.ship_video", "run"),
+    "solent-ais": ("seawatch.scenarios.solent_ais", "run"),
 }
 """Experiment name → (module, function)."""
 
