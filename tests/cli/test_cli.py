@@ -36,9 +36,7 @@ def test_every_sub_command_help_shows_an_example(command):
 
 
 def test_bench_filters_json_is_one_document_with_ratios_and_agreement():
-    result = runner.invoke(
-        app, ["bench", "filters", "--steps", "2000", "--tracks", "100", "--repeats", "1", "--json"]
-    )
+    result = runner.invoke(app, ["bench", "filters", "--size", "2000", "--repeats", "1", "--json"])
     assert result.exit_code == 0, result.output
     doc = json.loads(result.stdout)
     assert doc["benchmark"] == "filters"

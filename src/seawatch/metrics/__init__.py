@@ -3,10 +3,24 @@
 * :mod:`seawatch.metrics.mot` — CLEAR-MOT (MOTA, MOTP, ID switches, FP, FN), identity
   (IDF1, IDP, IDR) and HOTA through TrackEval's metric classes, on pixel boxes (IoU) or
   points (distance): :func:`mot_metrics` for all three at once.
+* :mod:`seawatch.metrics.crlb` — the posterior Cramér–Rao bound (Tichavský recursion in a
+  singular-Q-safe form, ALGORITHMS.md §7) for linear models, sea-surface angle
+  measurements (uav-sea, solent-ais) and image-size range (air-range).
 * :mod:`seawatch.metrics.ospa` — OSPA and GOSPA distances between point sets, per time
   step and over a sequence.
 """
 
+from seawatch.metrics.crlb import (
+    PCRBResult,
+    air_range_pcrb,
+    curved_sea_range_bound,
+    flat_sea_range_bound,
+    pcrb_information,
+    pcrb_linear,
+    pcrb_nonlinear_measurement,
+    sea_surface_angles_pcrb,
+    uav_sea_pcrb,
+)
 from seawatch.metrics.mot import (
     ClearMetrics,
     HotaMetrics,
@@ -35,8 +49,12 @@ __all__ = [
     "HotaMetrics",
     "IdentityMetrics",
     "MOTMetrics",
+    "PCRBResult",
+    "air_range_pcrb",
     "box_iou",
     "clear_metrics",
+    "curved_sea_range_bound",
+    "flat_sea_range_bound",
     "gospa",
     "gospa_series",
     "hota_metrics",
@@ -45,4 +63,9 @@ __all__ = [
     "mot_metrics",
     "ospa",
     "ospa_series",
+    "pcrb_information",
+    "pcrb_linear",
+    "pcrb_nonlinear_measurement",
+    "sea_surface_angles_pcrb",
+    "uav_sea_pcrb",
 ]

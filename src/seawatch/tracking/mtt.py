@@ -1,0 +1,671 @@
+"""Multi-target tracking of ships: gating, global nearest neighbour, M-of-N, deletion.
+
+The classic track-oriented GNN tracker (Blackman & Popoli, *Design and Analysis of
+Modern Tracking Systems*, 1999, §6.2 and §9.3; Bar-Shalom, Willett & Tian,
+*Tracking and Data Fusion*, 2011, §3.2) for ships detected as points or boxes in the
+image (pixels) or as points on the sea (metres). One scan:
+
+1. **Predict** every track with its filter (nearly constant velocity model,
+   ALGORITHMS.md §5.2: ``x = [x, y, vx, vy]``).
+2. **Gate** (Mahalanobis): ``d²_ij = y_ijᵀ S_i⁻¹ y_ij`` with ``y_ij = z_j − H x_i`` and
+   ``S_i = H P_i Hᵀ + R``; detection j may update track i only if
+   ``d²_ij <= gamma = chi2.ppf(gate_probability, 2)``. Vectorised over the candidate
+   pairs of a sort-and-sweep prefilter (``|y| <= sqrt(gamma tr S_i)`` per axis), so the
+   cost grows with the pairs near each other rather than with tracks × detections.
+3. **Assign** (global nearest neighbour): among the gated pairs, the matching with the
+   most pairs and, among those, the least total cost ``d²_ij + ln det S_i`` (the
+   negative log-likelihood up to a constant, so a vague tentative track does not win a
+   detection from a tight confirmed one), by ``scipy.optimize.linear_sum_assignment``
+   on the rows and columns that have any gated pair.
+4. **Update** assigned tracks with their detection (Kalman update, Joseph form);
+   the others take a predict-only step (a miss).
+5. **Manage tracks**: an unassigned detection starts a *tentative* track
+   (``x0 = [z, 0, 0]``, ``P0 = diag(σ_z², σ_z², σ_v0², σ_v0²)``); a tentative track is
+   *confirmed* once it has M detections among its last N scans (M-of-N, counting its
+   birth) and is deleted as soon as it can no longer reach M within its first N scans;
+   a confirmed track is deleted after K consecutive misses. Track ids are integers that
+   are never reused.
+
+Boxes ``(x, y, w, h)`` (top-left corner, width, height) are tracked by their centre;
+the size is smoothed alongside by exponential smoothing of (w, h).
+
+Speed: with the default linear Kalman filter all tracks live in stacked arrays
+``X (T, 4)``, ``P (T, 4, 4)`` and every step is a handful of batched numpy operations
+(no Python loop over tracks). Any other filter of :mod:`seawatch.filters` (the strong
+tracking KF, the (adaptive) fractional KF) or a user factory runs as one filter object
+per track.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import linear_sum_assignment
+from scipy.stats import chi2
+
+from seawatch._validation import FloatArray, as_float_array, in_range, positive
+from seawatch.filters.fractional import FractionalKalmanFilter
+from seawatch.filters.kalman import KalmanFilter
+from seawatch.models.kinematic import constant_velocity, position_measurement
+
+__all__ = [
+    "MultiTargetTracker",
+    "TrackFilter",
+    "TrackStates",
+    "gnn_assign",
+    "tracks_to_mot",
+]
+
+_DIM = 2  # tracked position axes
+_N = 2 * _DIM  # state size [x, y, vx, vy]
+_UNGATED = 1.0e12  # cost of a pair outside the gate inside the assignment solver
+
+
+class TrackFilter(Protocol):
+    """What the tracker needs of a per-track filter (every filter of seawatch.filters)."""
+
+    x: Any
+    P: Any
+
+    def predict(self) -> None: ...
+
+    def update(self, z: Any) -> None: ...
+
+
+FilterFactory = Callable[[FloatArray, FloatArray], TrackFilter]
+
+
+# --------------------------------------------------------------------------------------
+# results
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class TrackStates:
+    """The live tracks after one scan (rows in order of track id).
+
+    Attributes:
+        time: scan time [s, or frames when the tracker runs on frame numbers].
+        ids: track ids, (k,) int64, stable over the life of a track, never reused.
+        states: filter states ``[x, y, vx, vy]``, (k, 4), in the detections' units
+            (px or m) and those units per time unit.
+        covariances: state covariances, (k, 4, 4).
+        confirmed: True for confirmed tracks, False for tentative ones, (k,).
+        misses: consecutive scans without a detection, (k,) int64 (0: updated in this
+            scan; a confirmed track with misses > 0 is coasting on its prediction).
+        hits: detections assigned to the track so far, (k,) int64.
+        detection: index of the detection (in this scan's input, NaN rows counted)
+            that updated or started the track, -1 if none, (k,) int64.
+        boxes: smoothed boxes ``(x, y, w, h)`` around the estimated centre, (k, 4), in
+            px; ``None`` when the detections are points.
+    """
+
+    time: float
+    ids: NDArray[np.int64]
+    states: FloatArray
+    covariances: FloatArray
+    confirmed: NDArray[np.bool_]
+    misses: NDArray[np.int64]
+    hits: NDArray[np.int64]
+    detection: NDArray[np.int64]
+    boxes: FloatArray | None = None
+
+    def __len__(self) -> int:
+        return int(self.ids.shape[0])
+
+    def __iter__(self) -> Iterator[tuple[int, FloatArray, FloatArray, str]]:
+        """``(track_id, state, covariance, status)`` per track, status "confirmed" or
+        "tentative"."""
+        status = self.status
+        for i in range(len(self)):
+            yield int(self.ids[i]), self.states[i], self.covariances[i], str(status[i])
+
+    @property
+    def status(self) -> NDArray[np.str_]:
+        """ "confirmed" or "tentative" per track, (k,)."""
+        return np.where(self.confirmed, "confirmed", "tentative")
+
+    @property
+    def positions(self) -> FloatArray:
+        """Estimated positions (centres for boxes), (k, 2)."""
+        return self.states[:, :_DIM]
+
+    def select(self, mask: NDArray[np.bool_]) -> TrackStates:
+        """The subset of tracks where ``mask`` is True."""
+        return TrackStates(
+            time=self.time,
+            ids=self.ids[mask],
+            states=self.states[mask],
+            covariances=self.covariances[mask],
+            confirmed=self.confirmed[mask],
+            misses=self.misses[mask],
+            hits=self.hits[mask],
+            detection=self.detection[mask],
+            boxes=None if self.boxes is None else self.boxes[mask],
+        )
+
+    def confirmed_tracks(self) -> TrackStates:
+        """Only the confirmed tracks."""
+        return self.select(self.confirmed)
+
+
+# --------------------------------------------------------------------------------------
+# assignment
+# --------------------------------------------------------------------------------------
+
+
+def gnn_assign(cost: ArrayLike, gated: ArrayLike) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Global-nearest-neighbour assignment restricted to gated pairs.
+
+    Finds, among the one-to-one matchings that use only pairs with ``gated[i, j]``, one
+    with the most pairs and, among those, the least total ``cost`` (the solver sees
+    ``cost`` on gated pairs and a prohibitive constant elsewhere, so every ungated pair it
+    must use costs more than any gated matching could save; those pairs are dropped).
+    Only rows and columns with at least one gated pair enter the solver.
+
+    Args:
+        cost: (T, D) cost of assigning detection j to track i (any finite real).
+        gated: (T, D) bool, True where the pair passes the gate.
+
+    Returns:
+        ``(rows, cols)``: the assigned track and detection indices, sorted by row.
+    """
+    gate = np.asarray(gated, dtype=bool)
+    c = np.asarray(cost, dtype=np.float64)
+    if c.shape != gate.shape or c.ndim != 2:
+        raise ValueError(f"cost: expected the shape of gated {gate.shape}, got {c.shape}")
+    rows, cols = np.nonzero(gate)
+    return _assign_pairs(rows, cols, c[rows, cols])
+
+
+def _assign_pairs(
+    rows: NDArray[np.intp], cols: NDArray[np.intp], cost: FloatArray
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """:func:`gnn_assign` on a sparse list of gated pairs ``(rows[k], cols[k], cost[k])``."""
+    if rows.size == 0:
+        empty = np.empty(0, np.int64)
+        return empty, empty
+    if not np.all(np.isfinite(cost)):
+        raise ValueError("cost: contains NaN or inf on a gated pair")
+    urows, ri = np.unique(rows, return_inverse=True)
+    ucols, ci = np.unique(cols, return_inverse=True)
+    sub = np.full((urows.size, ucols.size), _UNGATED)
+    sub[ri, ci] = cost
+    sub_gate = np.zeros(sub.shape, bool)
+    sub_gate[ri, ci] = True
+    r, k = linear_sum_assignment(sub)
+    ok = sub_gate[r, k]
+    return urows[r[ok]].astype(np.int64), ucols[k[ok]].astype(np.int64)
+
+
+# --------------------------------------------------------------------------------------
+# the tracker
+# --------------------------------------------------------------------------------------
+
+
+def _count(name: str, value: int, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
+        raise ValueError(f"{name}: expected an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+class MultiTargetTracker:
+    """GNN multi-target tracker with M-of-N confirmation (module docstring, steps 1–5).
+
+    Args:
+        filter_factory: the filter each track runs.
+
+            * ``None`` or :class:`~seawatch.filters.KalmanFilter` (default): the linear
+              Kalman filter, run batched over all tracks at once (fast path).
+            * :class:`~seawatch.filters.StrongTrackingKalmanFilter` or any class taking
+              ``(F, H, Q, R, x0, P0, **filter_options)``: one object per track built from
+              the tracker's CV model.
+            * :class:`~seawatch.filters.FractionalKalmanFilter` or
+              :class:`~seawatch.filters.AdaptiveFractionalKalmanFilter`: one object per
+              track from ``cls.for_image_tracking(dt, sigma_a, sigma_z, sigma_v0, x0,
+              **filter_options)``.
+            * any other callable ``factory(x0, P0) -> filter`` with ``predict()``,
+              ``update(z)`` (``None`` for a miss) and attributes ``x`` (4,), ``P`` (4, 4).
+
+            Gating uses each track's predicted ``P`` with the tracker's ``H`` and ``R``.
+        dt: nominal scan interval [s or frames] (used when ``step`` gets no time).
+        sigma_a: acceleration noise of the CV model [units/dt²] (discrete white-noise
+            acceleration, ALGORITHMS.md §5.2).
+        sigma_z: measurement noise of a detection position [px or m] (``R = σ_z² I``).
+        sigma_v0: initial velocity uncertainty of a new track [units/dt], about the
+            largest speed expected.
+        gate_probability: probability that a true detection falls inside the gate
+            (``gamma = chi2.ppf(gate_probability, 2)``; 0.99 → 9.21).
+        gate_threshold: the gate ``gamma`` on d² directly (overrides the probability).
+        confirm_m, confirm_n: M-of-N confirmation (1 <= M <= N).
+        delete_after: K, consecutive misses that delete a confirmed track (>= 1).
+        size_smoothing: weight of a new box size in the exponential smoothing of
+            (w, h), in (0, 1] (1: no smoothing).
+        filter_options: extra keyword arguments for a filter class (see above).
+    """
+
+    def __init__(
+        self,
+        filter_factory: type | FilterFactory | None = None,
+        *,
+        dt: float = 1.0,
+        sigma_a: float = 0.5,
+        sigma_z: float = 2.0,
+        sigma_v0: float = 10.0,
+        gate_probability: float = 0.99,
+        gate_threshold: float | None = None,
+        confirm_m: int = 3,
+        confirm_n: int = 5,
+        delete_after: int = 3,
+        size_smoothing: float = 0.3,
+        filter_options: dict[str, Any] | None = None,
+    ) -> None:
+        self.dt = positive("dt", dt)
+        self.sigma_a = positive("sigma_a", sigma_a, allow_zero=True)
+        self.sigma_z = positive("sigma_z", sigma_z)
+        self.sigma_v0 = positive("sigma_v0", sigma_v0)
+        if gate_threshold is None:
+            p = in_range("gate_probability", gate_probability, 0.0, 1.0, lo_open=True, hi_open=True)
+            self.gate = float(chi2.ppf(p, _DIM))
+        else:
+            self.gate = positive("gate_threshold", gate_threshold)
+        self.confirm_n = _count("confirm_n", confirm_n, 1)
+        self.confirm_m = _count("confirm_m", confirm_m, 1)
+        if self.confirm_m > self.confirm_n:
+            raise ValueError(f"confirm_m: expected <= confirm_n = {confirm_n}, got {confirm_m}")
+        if self.confirm_n > 62:
+            raise ValueError(f"confirm_n: expected <= 62, got {confirm_n}")
+        self.delete_after = _count("delete_after", delete_after, 1)
+        self.size_smoothing = in_range("size_smoothing", size_smoothing, 0.0, 1.0, lo_open=True)
+        self.filter_options = dict(filter_options or {})
+        self.H = position_measurement(_DIM, 2)
+        self.R = self.sigma_z**2 * np.eye(_DIM)
+        self.P0 = np.diag([self.sigma_z**2] * _DIM + [self.sigma_v0**2] * _DIM)
+        self.F, self.Q = constant_velocity(_DIM, self.dt, self.sigma_a)
+        self._factory = self._make_factory(filter_factory)
+        self.batched = self._factory is None
+        self.reset()
+
+    # ------------------------------------------------------------------ set-up
+    def _make_factory(self, factory: type | FilterFactory | None) -> FilterFactory | None:
+        opts = self.filter_options
+        if factory is None or factory is KalmanFilter:
+            if opts:
+                raise ValueError(
+                    f"filter_options: the default Kalman filter takes none, got {sorted(opts)}"
+                )
+            return None
+        if isinstance(factory, type) and issubclass(factory, FractionalKalmanFilter):
+            cls = factory
+
+            def fractional(x0: FloatArray, P0: FloatArray) -> TrackFilter:
+                return cls.for_image_tracking(
+                    dt=self.dt, sigma_a=self.sigma_a, sigma_z=self.sigma_z,
+                    sigma_v0=self.sigma_v0, x0=x0, **opts,
+                )  # fmt: skip
+
+            _probe(fractional, self.P0)
+            return fractional
+        if isinstance(factory, type):
+            cls = factory
+
+            def linear(x0: FloatArray, P0: FloatArray) -> TrackFilter:
+                return cls(self.F, self.H, self.Q, self.R, x0, P0, **opts)
+
+            _probe(linear, self.P0)
+            return linear
+        if not callable(factory):
+            raise ValueError(
+                f"filter_factory: expected a filter class or a callable, got {factory!r}"
+            )
+        if opts:
+            raise ValueError("filter_options: only for filter classes, not for a factory")
+        return factory
+
+    def reset(self) -> None:
+        """Forget all tracks (ids restart at 1) and the last scan time."""
+        self._X = np.empty((0, _N))
+        self._P = np.empty((0, _N, _N))
+        self._ids = np.empty(0, np.int64)
+        self._history = np.empty(0, np.int64)  # bit i: detection i scans ago
+        self._age = np.empty(0, np.int64)  # scans since birth, birth scan = 1
+        self._hits = np.empty(0, np.int64)
+        self._misses = np.empty(0, np.int64)
+        self._confirmed = np.empty(0, bool)
+        self._size = np.empty((0, 2))
+        self._filters: list[TrackFilter] = []
+        self._next_id = 1
+        self._time: float | None = None
+        self._boxes: bool | None = None
+
+    @property
+    def n_tracks(self) -> int:
+        """Number of live tracks (tentative and confirmed)."""
+        return int(self._ids.shape[0])
+
+    # ------------------------------------------------------------------ input
+    def _detections(self, detections: ArrayLike | None) -> tuple[FloatArray, FloatArray | None]:
+        """Centres (D, 2) and sizes (D, 2) or None; rows with NaN/inf get NaN centres."""
+        if detections is None:
+            z = np.empty((0, _DIM))
+        else:
+            z = as_float_array("detections", detections)
+        if z.ndim == 1 and z.size == 0:
+            z = z.reshape(0, _DIM if not self._boxes else 4)
+        if z.ndim != 2 or z.shape[1] not in (2, 4):
+            raise ValueError(
+                "detections: expected points (k, 2) or boxes (k, 4) as (x, y, w, h), "
+                f"got shape {z.shape}"
+            )
+        boxes = z.shape[1] == 4
+        if z.shape[0] > 0:
+            if self._boxes is None:
+                self._boxes = boxes
+            elif self._boxes != boxes:
+                kind = "boxes (k, 4)" if self._boxes else "points (k, 2)"
+                raise ValueError(f"detections: this tracker tracks {kind}, got shape {z.shape}")
+        if not boxes:
+            return z, None
+        if np.any(z[:, 2:] < 0):
+            raise ValueError("detections: box width and height must be >= 0")
+        return z[:, :2] + 0.5 * z[:, 2:], z[:, 2:]
+
+    def _step_time(self, time: float | None) -> float:
+        if time is None:
+            return 0.0 if self._time is None else self._time + self.dt
+        t = float(time)
+        if not math.isfinite(t):
+            raise ValueError(f"time: expected a finite number, got {time!r}")
+        if self._time is not None and t <= self._time:
+            raise ValueError(
+                f"time: scans must come in increasing time order, got {t} after {self._time}"
+            )
+        return t
+
+    # ------------------------------------------------------------------ one scan
+    def step(self, detections: ArrayLike | None, time: float | None = None) -> TrackStates:
+        """Process one scan of detections and return the live tracks.
+
+        Args:
+            detections: points (k, 2) as (x, y) or boxes (k, 4) as (x, y, w, h) with the
+                top-left corner, in px or m; ``None`` or an empty array for an empty
+                scan. Rows with NaN or inf are ignored (they keep their index in
+                ``TrackStates.detection``).
+            time: scan time [s or frames], strictly increasing; default: 0 for the
+                first scan, then the previous time plus ``dt``. The prediction uses the
+                actual interval (the default filter and the KalmanFilter class; other
+                per-track filters need the nominal ``dt``).
+
+        Returns:
+            :class:`TrackStates` of every live track after this scan.
+        """
+        centres, sizes = self._detections(detections)
+        t = self._step_time(time)
+        dt = self.dt if self._time is None else t - self._time
+        valid = np.flatnonzero(np.all(np.isfinite(centres), axis=1))
+        if sizes is not None:
+            valid = valid[np.all(np.isfinite(sizes[valid]), axis=1)]
+        z = centres[valid]
+
+        # 1. predict
+        self._predict(dt)
+        # 2.–3. gate and assign
+        rows, cols = self._associate(z)
+        # 4. update assigned tracks, misses for the others
+        assigned = np.zeros(self.n_tracks, bool)
+        assigned[rows] = True
+        self._update(rows, z[cols])
+        detection = np.full(self.n_tracks, -1, np.int64)
+        detection[rows] = valid[cols]
+        if sizes is not None and rows.size:
+            s = self.size_smoothing
+            self._size[rows] += s * (sizes[valid[cols]] - self._size[rows])
+        # 5. track management
+        mask_n = (1 << self.confirm_n) - 1
+        self._history = ((self._history << 1) | assigned) & mask_n
+        self._age += 1
+        self._hits += assigned
+        self._misses = np.where(assigned, 0, self._misses + 1)
+        window_hits = _popcount(self._history)
+        newly = ~self._confirmed & (window_hits >= self.confirm_m)
+        self._confirmed |= newly
+        can_confirm = window_hits + np.maximum(self.confirm_n - self._age, 0) >= self.confirm_m
+        keep = np.where(self._confirmed, self._misses < self.delete_after, can_confirm)
+        self._compress(keep)
+        detection = detection[keep]
+        free = np.ones(valid.size, bool)
+        free[cols] = False
+        births = valid[free]
+        self._birth(centres[births], None if sizes is None else sizes[births])
+        detection = np.concatenate([detection, births.astype(np.int64)])
+        self._time = t
+        return self._report(t, detection)
+
+    def run(
+        self, scans: Sequence[ArrayLike | None], times: ArrayLike | None = None
+    ) -> list[TrackStates]:
+        """:meth:`step` over a sequence of scans (``times`` optional, one per scan)."""
+        if times is None:
+            return [self.step(d) for d in scans]
+        ts = as_float_array("times", times, ndim=1)
+        if ts.shape[0] != len(scans):
+            raise ValueError(f"times: expected {len(scans)} times, got {ts.shape[0]}")
+        return [self.step(d, float(t)) for d, t in zip(scans, ts, strict=True)]
+
+    # ------------------------------------------------------------------ pieces
+    def _model(self, dt: float) -> tuple[FloatArray, FloatArray]:
+        if abs(dt - self.dt) <= 1e-9 * self.dt:  # the nominal interval, up to rounding
+            return self.F, self.Q
+        return constant_velocity(_DIM, dt, self.sigma_a)
+
+    def _predict(self, dt: float) -> None:
+        """Time update of every track (ALGORITHMS.md §5.2 CV model)."""
+        if self.n_tracks == 0:
+            return
+        F, Q = self._model(dt)
+        if self.batched:
+            self._X = self._X @ F.T
+            P = F @ self._P @ F.T + Q
+            self._P = 0.5 * (P + np.swapaxes(P, 1, 2))
+            return
+        for f in self._filters:
+            if F is self.F:
+                f.predict()
+            else:
+                try:
+                    f.predict(F=F, Q=Q)  # type: ignore[call-arg]
+                except TypeError:
+                    raise ValueError(
+                        f"time: an interval of {dt} differs from dt = {self.dt}; the filter "
+                        f"{type(f).__name__} cannot change its model per step"
+                    ) from None
+        self._pull()
+
+    def _pull(self) -> None:
+        """Copy the per-track filters' estimates into the stacked arrays."""
+        if self._filters:
+            self._X = np.stack([np.asarray(f.x, dtype=np.float64) for f in self._filters])
+            self._P = np.stack([np.asarray(f.P, dtype=np.float64) for f in self._filters])
+
+    def _innovation_covariance(self) -> FloatArray:
+        S = self.H @ self._P @ self.H.T + self.R
+        return 0.5 * (S + np.swapaxes(S, 1, 2))
+
+    def _associate(self, z: FloatArray) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        """Mahalanobis gate and GNN assignment; returns (track rows, detection indices).
+
+        Candidate pairs come from a sort-and-sweep prefilter: ``d² <= gamma`` implies
+        ``|y_x|, |y_y| <= sqrt(gamma · tr S)``, so only detections within that box of a
+        track's predicted position (found by ``searchsorted`` on the x-sorted detections)
+        get their exact d². The work grows with the pairs near each other, not with
+        tracks × detections.
+        """
+        empty = np.empty(0, np.int64)
+        T, D = self.n_tracks, z.shape[0]
+        if T == 0 or D == 0:
+            return empty, empty
+        S = self._innovation_covariance()
+        a, b, d = S[:, 0, 0], S[:, 0, 1], S[:, 1, 1]
+        det = a * d - b * b
+        if np.any(det <= 0.0):
+            raise np.linalg.LinAlgError(
+                "MultiTargetTracker: an innovation covariance H P Hᵀ + R is not positive "
+                "definite; check sigma_z and the filter's covariance"
+            )
+        pred = self._X @ self.H.T  # (T, 2) predicted positions
+        radius = np.sqrt(self.gate * (a + d))
+        order = np.argsort(z[:, 0], kind="stable")
+        zx = z[order, 0]
+        lo = np.searchsorted(zx, pred[:, 0] - radius, side="left")
+        hi = np.searchsorted(zx, pred[:, 0] + radius, side="right")
+        counts = hi - lo
+        total = int(counts.sum())
+        if total == 0:
+            return empty, empty
+        rows = np.repeat(np.arange(T), counts)
+        starts = np.repeat(lo - (np.cumsum(counts) - counts), counts)
+        cols = order[starts + np.arange(total)]
+        y = z[cols] - pred[rows]
+        near = np.abs(y[:, 1]) <= radius[rows]
+        rows, cols, y = rows[near], cols[near], y[near]
+        # d² with the closed-form inverse of the 2 x 2 innovation covariances
+        ar, br, dr, detr = a[rows], b[rows], d[rows], det[rows]
+        d2 = (dr * y[:, 0] ** 2 - 2.0 * br * y[:, 0] * y[:, 1] + ar * y[:, 1] ** 2) / detr
+        gated = d2 <= self.gate
+        rows, cols = rows[gated], cols[gated]
+        return _assign_pairs(rows, cols, d2[gated] + np.log(detr[gated]))
+
+    def _update(self, rows: NDArray[np.int64], z: FloatArray) -> None:
+        """Kalman update of the assigned tracks (Joseph form), predict-only for the rest."""
+        if self.batched:
+            if rows.size == 0:
+                return
+            H, R = self.H, self.R
+            x = self._X[rows]
+            P = self._P[rows]
+            PHt = P @ H.T  # (a, 4, 2)
+            S = H @ PHt + R
+            K = np.linalg.solve(S, np.swapaxes(PHt, 1, 2)).transpose(0, 2, 1)  # P Hᵀ S⁻¹
+            innov = z - x @ H.T
+            self._X[rows] = x + np.einsum("aij,aj->ai", K, innov)
+            A = np.eye(_N) - K @ H
+            P = A @ P @ np.swapaxes(A, 1, 2) + K @ R @ np.swapaxes(K, 1, 2)
+            self._P[rows] = 0.5 * (P + np.swapaxes(P, 1, 2))
+            return
+        zz: list[FloatArray | None] = [None] * len(self._filters)
+        for i, r in enumerate(rows):
+            zz[int(r)] = z[i]
+        for f, zi in zip(self._filters, zz, strict=True):
+            f.update(zi)
+        self._pull()
+
+    def _compress(self, keep: NDArray[np.bool_]) -> None:
+        if keep.all():
+            return
+        self._X = self._X[keep]
+        self._P = self._P[keep]
+        self._ids = self._ids[keep]
+        self._history = self._history[keep]
+        self._age = self._age[keep]
+        self._hits = self._hits[keep]
+        self._misses = self._misses[keep]
+        self._confirmed = self._confirmed[keep]
+        self._size = self._size[keep]
+        if self._filters:
+            self._filters = [f for f, k in zip(self._filters, keep, strict=True) if k]
+
+    def _birth(self, z: FloatArray, sizes: FloatArray | None) -> None:
+        """Tentative tracks ``x0 = [z, 0, 0]``, ``P0 = diag(σ_z², σ_z², σ_v0², σ_v0²)``."""
+        k = z.shape[0]
+        if k == 0:
+            return
+        x0 = np.zeros((k, _N))
+        x0[:, :_DIM] = z
+        P0 = np.broadcast_to(self.P0, (k, _N, _N))
+        if self._factory is not None:
+            self._filters.extend(self._factory(x0[i].copy(), self.P0.copy()) for i in range(k))
+        self._X = np.concatenate([self._X, x0])
+        self._P = np.concatenate([self._P, P0])
+        self._ids = np.concatenate([self._ids, np.arange(self._next_id, self._next_id + k)])
+        self._next_id += k
+        ones = np.ones(k, np.int64)
+        self._history = np.concatenate([self._history, ones])
+        self._age = np.concatenate([self._age, ones])
+        self._hits = np.concatenate([self._hits, ones])
+        self._misses = np.concatenate([self._misses, np.zeros(k, np.int64)])
+        self._confirmed = np.concatenate([self._confirmed, np.full(k, self.confirm_m <= 1)])
+        size = np.zeros((k, 2)) if sizes is None else sizes
+        self._size = np.concatenate([self._size, size])
+
+    def _report(self, t: float, detection: NDArray[np.int64]) -> TrackStates:
+        boxes = None
+        if self._boxes:
+            boxes = np.concatenate([self._X[:, :_DIM] - 0.5 * self._size, self._size], axis=1)
+        return TrackStates(
+            time=t,
+            ids=self._ids.copy(),
+            states=self._X.copy(),
+            covariances=self._P.copy(),
+            confirmed=self._confirmed.copy(),
+            misses=self._misses.copy(),
+            hits=self._hits.copy(),
+            detection=detection,
+            boxes=boxes,
+        )
+
+
+def _probe(factory: FilterFactory, P0: FloatArray) -> None:
+    """Build one filter now, so that bad ``filter_options`` fail at construction."""
+    try:
+        factory(np.zeros(_N), P0.copy())
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"filter_options: the filter rejects them: {exc}") from exc
+
+
+def _popcount(v: NDArray[np.int64]) -> NDArray[np.int64]:
+    """Number of set bits of each (non-negative, < 2**62) integer."""
+    return np.bitwise_count(v).astype(np.int64)
+
+
+def tracks_to_mot(
+    history: Sequence[TrackStates],
+    *,
+    frames: ArrayLike | None = None,
+    confirmed_only: bool = True,
+    boxes: bool | None = None,
+) -> FloatArray:
+    """Rows ``(frame, id, x, y, w, h)`` (boxes) or ``(frame, id, x, y)`` (points) in MOT order.
+
+    Args:
+        history: the tracker's outputs, one per scan.
+        frames: frame number of each scan (default 0, 1, 2, …).
+        confirmed_only: only confirmed tracks (default), else tentative ones too.
+        boxes: write boxes (default: when the tracker tracked boxes).
+
+    Returns:
+        (N, 6) or (N, 4) float array, sorted by frame then id; the input format of
+        :func:`seawatch.metrics.mot_metrics`.
+    """
+    fr = np.arange(len(history)) if frames is None else as_float_array("frames", frames, ndim=1)
+    if fr.shape[0] != len(history):
+        raise ValueError(f"frames: expected {len(history)} frame numbers, got {fr.shape[0]}")
+    use_boxes = boxes if boxes is not None else any(h.boxes is not None for h in history if len(h))
+    parts = []
+    for f, h in zip(fr, history, strict=True):
+        sel = h.confirmed_tracks() if confirmed_only else h
+        if len(sel) == 0:
+            continue
+        if use_boxes:
+            if sel.boxes is None:
+                raise ValueError("boxes: the tracks hold points, not boxes")
+            geom = sel.boxes
+        else:
+            geom = sel.positions
+        parts.append(np.column_stack([np.full(len(sel), f), sel.ids, geom]))
+    width = 6 if use_boxes else 4
+    return np.concatenate(parts) if parts else np.empty((0, width))

@@ -1,0 +1,341 @@
+"""Multi-target tracker: association, M-of-N logic, ids, filters, bad input.
+
+Independent truths: brute-force enumeration of assignments, the compiled
+``KalmanFilter`` (per-track objects and ``filter``) as the reference for the batched
+numpy update, simulated scenarios with known truth scored by TrackEval (MOTA, IDF1), and
+hand-derived confirmation/deletion timings.
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+
+import numpy as np
+import pytest
+
+from seawatch.bench import mtt as bench
+from seawatch.filters import (
+    AdaptiveFractionalKalmanFilter,
+    KalmanFilter,
+    StrongTrackingKalmanFilter,
+)
+from seawatch.metrics import mot_metrics
+from seawatch.tracking.mtt import MultiTargetTracker, gnn_assign, tracks_to_mot
+
+# ------------------------------------------------------------------ helpers
+
+
+def _crossing(scans=60, clutter=0, seed=1234, noise=0.5, area=400.0):
+    """Two targets crossing at right angles in the middle of the run (same point, same
+    scan), optionally in uniform clutter."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(scans, dtype=float)
+    mid = scans / 2
+    a = np.column_stack([100 + 3.0 * (t - mid) + 100, 200 + 0 * t])
+    b = np.column_stack([200 + 0 * t, 100 + 3.0 * (t - mid) + 100])
+    truth = np.stack([a, b], axis=1)  # (scans, 2, 2): both at (200, 200) at t = mid
+    scans_z = []
+    for k in range(scans):
+        z = truth[k] + rng.normal(0.0, noise, size=(2, 2))
+        c = rng.uniform(0.0, area, size=(clutter, 2))
+        both = np.concatenate([z, c])
+        scans_z.append(both[rng.permutation(both.shape[0])])
+    return truth, scans_z
+
+
+def _truth_rows(truth):
+    scans, n, _ = truth.shape
+    return np.column_stack(
+        [np.repeat(np.arange(scans), n), np.tile(np.arange(1, n + 1), scans), truth.reshape(-1, 2)]
+    )
+
+
+def _id_sequences(history, truth, radius=3.0, skip=()):
+    """For each truth object, the confirmed track ids nearest to it scan by scan (scans in
+    ``skip``, where the targets are too close to tell apart this way, left out)."""
+    seqs = [[] for _ in range(truth.shape[1])]
+    for k, h in enumerate(history):
+        if k in skip:
+            continue
+        conf = h.confirmed_tracks()
+        for j in range(truth.shape[1]):
+            if len(conf) == 0:
+                continue
+            d = np.linalg.norm(conf.positions - truth[k, j], axis=1)
+            if d.min() < radius:
+                seqs[j].append(int(conf.ids[np.argmin(d)]))
+    return seqs
+
+
+def _tracker(**kw):
+    opts = {"sigma_a": 0.2, "sigma_z": 1.0, "sigma_v0": 5.0}
+    opts.update(kw)
+    return MultiTargetTracker(**opts)
+
+
+# ------------------------------------------------------------------ assignment
+
+
+def _brute_force(cost, gated):
+    """Best matching over gated pairs: most pairs first, then least total cost."""
+    T, D = cost.shape
+    pairs = [(i, j) for i in range(T) for j in range(D) if gated[i, j]]
+    best = (0, 0.0)
+    for r in range(len(pairs), 0, -1):
+        found = None
+        for combo in itertools.combinations(pairs, r):
+            rows = {p[0] for p in combo}
+            cols = {p[1] for p in combo}
+            if len(rows) == r and len(cols) == r:
+                total = sum(cost[p] for p in combo)
+                if found is None or total < found:
+                    found = total
+        if found is not None:
+            best = (r, found)
+            break
+    return best
+
+
+def test_gnn_assignment_equals_brute_force_enumeration():
+    rng = np.random.default_rng(1234)
+    for _ in range(150):
+        T, D = rng.integers(1, 5), rng.integers(1, 5)
+        cost = rng.normal(0.0, 3.0, size=(T, D))
+        gated = rng.random((T, D)) < 0.6
+        rows, cols = gnn_assign(cost, gated)
+        assert len(set(rows)) == len(rows) and len(set(cols)) == len(cols)
+        assert np.all(gated[rows, cols])
+        n, total = _brute_force(cost, gated)
+        assert len(rows) == n
+        assert cost[rows, cols].sum() == pytest.approx(total, abs=1e-9)
+
+
+def test_gnn_assignment_of_nothing_gated_is_empty():
+    rows, cols = gnn_assign(np.zeros((3, 4)), np.zeros((3, 4), bool))
+    assert rows.size == 0 and cols.size == 0
+
+
+# ------------------------------------------------------------------ reference filters
+
+
+def test_batched_kalman_path_equals_per_track_kalman_filter_objects():
+    sc = bench.scenario(30, 10, 50, seed=3)
+    fast = bench.tracker()
+    slow = bench.tracker(per_track_filters=True)
+    assert fast.batched and not slow.batched
+    for z in sc.detections:
+        a, b = fast.step(z), slow.step(z)
+        np.testing.assert_array_equal(a.ids, b.ids)
+        np.testing.assert_array_equal(a.confirmed, b.confirmed)
+        np.testing.assert_allclose(a.states, b.states, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(a.covariances, b.covariances, rtol=0, atol=1e-9)
+
+
+def test_single_target_track_equals_kalman_filter_over_its_measurements():
+    rng = np.random.default_rng(1234)
+    zs = np.column_stack([10 + 2.0 * np.arange(30), 50 - 1.0 * np.arange(30)])
+    zs = zs + rng.normal(0.0, 1.0, size=zs.shape)
+    trk = _tracker()
+    for z in zs:
+        out = trk.step(z[None])
+    assert len(out) == 1 and out.confirmed[0]
+    kf = KalmanFilter(trk.F, trk.H, trk.Q, trk.R, np.r_[zs[0], 0.0, 0.0], trk.P0)
+    ref = kf.filter(zs[1:])
+    np.testing.assert_allclose(out.states[0], ref.states[-1], atol=1e-9)
+    np.testing.assert_allclose(out.covariances[0], ref.covariances[-1], atol=1e-9)
+
+
+def test_irregular_scan_times_use_the_actual_interval():
+    times = np.cumsum(np.r_[0.0, np.random.default_rng(1234).uniform(0.5, 2.0, 40)])
+    truth = np.column_stack([3.0 * times, 100 + 0.5 * times])
+    fast = _tracker()
+    slow = MultiTargetTracker(
+        lambda x0, P0: KalmanFilter(fast.F, fast.H, fast.Q, fast.R, x0, P0),
+        sigma_a=0.2, sigma_z=1.0, sigma_v0=5.0,
+    )  # fmt: skip
+    for t, z in zip(times, truth, strict=True):
+        a, b = fast.step(z[None], t), slow.step(z[None], t)
+        np.testing.assert_allclose(a.states, b.states, atol=1e-9)
+    np.testing.assert_allclose(a.states[0, 2:], [3.0, 0.5], atol=1e-3)  # velocity per time unit
+    stkf = MultiTargetTracker(StrongTrackingKalmanFilter, sigma_z=1.0)
+    stkf.step(truth[:1], 0.0)
+    stkf.step(truth[1:2], 1.0)
+    with pytest.raises(ValueError, match="time"):
+        stkf.step(truth[2:3], 2.7)
+
+
+# ------------------------------------------------------------------ scenarios
+
+
+@pytest.mark.parametrize("clutter", [0, 20])
+def test_crossing_targets_keep_their_ids_and_high_mota(clutter):
+    truth, scans = _crossing(clutter=clutter)
+    trk = _tracker(confirm_m=4, confirm_n=5)
+    history = trk.run(scans)
+    mid = len(scans) // 2
+    for seq in _id_sequences(history, truth, skip=range(mid - 2, mid + 3)):
+        assert len(seq) >= len(scans) - 10
+        assert len(set(seq)) == 1  # one id per target, through the crossing
+    m = mot_metrics(_truth_rows(truth), tracks_to_mot(history), "distance", max_distance=6.0)
+    assert m.clear.id_switches == 0
+    assert m.mota >= 0.9 and m.idf1 >= 0.9
+
+
+@pytest.mark.parametrize("factory", [StrongTrackingKalmanFilter, AdaptiveFractionalKalmanFilter])
+def test_crossing_targets_tracked_with_strong_tracking_and_fractional_filters(factory):
+    truth, scans = _crossing(clutter=5)
+    trk = _tracker(filter_factory=factory, confirm_m=4, confirm_n=5)
+    assert not trk.batched
+    history = trk.run(scans)
+    m = mot_metrics(_truth_rows(truth), tracks_to_mot(history), "distance", max_distance=6.0)
+    assert m.mota >= 0.85 and m.idf1 >= 0.85
+    assert m.clear.id_switches <= 1
+
+
+def test_benchmark_scenario_ten_targets_in_clutter_is_tracked_well():
+    sc = bench.scenario(200, 10, 50, seed=5)
+    history = bench.tracker().run(sc.detections)
+    q = bench.quality(sc, history)
+    assert q["mota"] >= 0.9 and q["idf1"] >= 0.85
+    assert q["ospa_mean_px"] < 3.0
+
+
+def test_boxes_are_tracked_by_centre_with_smoothed_size():
+    rng = np.random.default_rng(1234)
+    gt, scans = [], []
+    for k in range(40):
+        boxes = np.array([[100 + 4.0 * k, 300, 60, 20], [600 - 3.0 * k, 200 + k, 30, 30]])
+        gt.append(boxes)
+        noisy = boxes + np.column_stack([rng.normal(0, 1, (2, 2)), rng.normal(0, 2, (2, 2))])
+        scans.append(noisy)
+    trk = _tracker(sigma_v0=8.0, sigma_z=2.0)  # centre noise: sqrt(1 + (2 / 2)²) px
+    history = trk.run(scans)
+    last = history[-1].confirmed_tracks()
+    assert len(last) == 2 and last.boxes is not None
+    by_x = last.boxes[np.argsort(last.boxes[:, 0])]
+    want = gt[-1][np.argsort(gt[-1][:, 0])]
+    np.testing.assert_allclose(by_x[:, 2:], want[:, 2:], atol=3.0)  # smoothed sizes
+    np.testing.assert_allclose(by_x[:, :2], want[:, :2], atol=4.0)
+    rows = np.concatenate([np.column_stack([np.full(2, k), [1, 2], b]) for k, b in enumerate(gt)])
+    m = mot_metrics(rows, tracks_to_mot(history), "iou", 0.5)
+    assert m.mota > 0.85 and m.clear.id_switches == 0
+
+
+# ------------------------------------------------------------------ track management
+
+
+def test_three_of_five_confirms_at_the_third_hit_and_tentatives_die_when_hopeless():
+    trk = _tracker(confirm_m=3, confirm_n=5)
+    z = np.array([[10.0, 10.0]])
+    out = trk.step(z)  # scan 0: birth
+    assert out.ids.tolist() == [1] and not out.confirmed[0]
+    out = trk.step(z + np.array([1.0, 0.0]))  # scan 1: 2 hits
+    assert not out.confirmed[0]
+    out = trk.step(None)  # scan 2: miss, can still reach 3 of 5
+    assert len(out) == 1 and out.misses[0] == 1
+    out = trk.step(z + np.array([3.0, 0.0]))  # scan 3: third hit -> confirmed
+    assert out.confirmed[0] and out.hits[0] == 3
+    lone = _tracker(confirm_m=3, confirm_n=5)
+    lone.step(np.array([[500.0, 500.0]]))
+    assert len(lone.step(None)) == 1  # 1 hit + 3 scans left >= 3
+    assert len(lone.step(None)) == 1  # 1 hit + 2 scans left >= 3
+    assert len(lone.step(None)) == 0  # 1 hit + 1 scan left < 3: deleted
+
+
+def test_confirmed_track_is_deleted_after_k_consecutive_misses_and_ids_are_not_reused():
+    trk = _tracker(confirm_m=2, confirm_n=2, delete_after=3)
+    for k in range(4):
+        out = trk.step(np.array([[10.0 + k, 10.0]]))
+    assert out.confirmed.tolist() == [True] and out.ids.tolist() == [1]
+    assert trk.step(None).misses.tolist() == [1]
+    assert trk.step([]).misses.tolist() == [2]
+    assert len(trk.step(np.empty((0, 2)))) == 0  # third miss
+    assert trk.step(np.array([[10.0, 10.0]])).ids.tolist() == [2]
+
+
+def test_all_tracks_dying_leaves_a_working_tracker():
+    trk = _tracker()
+    trk.step(np.random.default_rng(1234).uniform(0, 100, (30, 2)))
+    for _ in range(6):
+        out = trk.step(None)
+    assert len(out) == 0 and trk.n_tracks == 0
+    out = trk.step(np.array([[5.0, 5.0]]))
+    assert out.ids.tolist() == [31]
+
+
+def test_track_states_iterate_as_id_state_covariance_status():
+    trk = _tracker(confirm_m=1, confirm_n=1)
+    out = trk.step(np.array([[1.0, 2.0], [50.0, 60.0]]))
+    items = list(out)
+    assert [i[0] for i in items] == [1, 2]
+    assert items[1][1].tolist() == [50.0, 60.0, 0.0, 0.0]
+    assert items[0][2].shape == (4, 4) and items[0][3] == "confirmed"
+    assert out.detection.tolist() == [0, 1]
+
+
+# ------------------------------------------------------------------ bad input
+
+
+def test_nan_detections_are_ignored_and_indices_kept():
+    trk = _tracker()
+    out = trk.step(np.array([[np.nan, 1.0], [3.0, 4.0], [np.inf, 0.0]]))
+    assert len(out) == 1 and out.detection.tolist() == [1]
+    np.testing.assert_array_equal(out.positions, [[3.0, 4.0]])
+
+
+def test_a_frame_with_a_thousand_detections_is_processed_quickly():
+    rng = np.random.default_rng(1234)
+    trk = _tracker()
+    t0 = time.perf_counter()
+    for _ in range(3):
+        out = trk.step(rng.uniform(0.0, 2000.0, size=(1000, 2)))
+    assert time.perf_counter() - t0 < 10.0
+    assert len(out) >= 1000
+    assert np.all(np.isfinite(out.states))
+
+
+def test_bad_detection_shapes_and_mixed_kinds_raise_naming_detections():
+    trk = _tracker()
+    for bad in (np.zeros((3, 3)), np.zeros(5), np.zeros((2, 2, 2)), [["a", "b"]]):
+        with pytest.raises(ValueError, match="detections"):
+            trk.step(bad)
+    trk.step(np.zeros((1, 2)))
+    with pytest.raises(ValueError, match="detections"):
+        trk.step(np.zeros((1, 4)))
+    with pytest.raises(ValueError, match="detections"):
+        _tracker().step(np.array([[0.0, 0.0, -1.0, 5.0]]))
+
+
+def test_non_increasing_times_raise_naming_time():
+    trk = _tracker()
+    trk.step(np.zeros((1, 2)), time=5.0)
+    with pytest.raises(ValueError, match="time"):
+        trk.step(np.zeros((1, 2)), time=5.0)
+    with pytest.raises(ValueError, match="time"):
+        trk.step(np.zeros((1, 2)), time=float("nan"))
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [
+        ({"confirm_m": 4, "confirm_n": 3}, "confirm_m"),
+        ({"confirm_n": 0}, "confirm_n"),
+        ({"delete_after": 0}, "delete_after"),
+        ({"gate_probability": 1.0}, "gate_probability"),
+        ({"gate_threshold": -1.0}, "gate_threshold"),
+        ({"sigma_z": 0.0}, "sigma_z"),
+        ({"dt": -1.0}, "dt"),
+        ({"size_smoothing": 0.0}, "size_smoothing"),
+        ({"filter_options": {"beta": 2.0}}, "filter_options"),
+        ({"filter_factory": 3}, "filter_factory"),
+        (
+            {"filter_factory": StrongTrackingKalmanFilter, "filter_options": {"beta": 0.5}},
+            "filter_options",
+        ),
+        ({"filter_factory": AdaptiveFractionalKalmanFilter, "filter_options": {"x": 1}}, "filter"),
+    ],
+)
+def test_bad_parameters_raise_naming_the_parameter(kwargs, name):
+    with pytest.raises(ValueError, match=name):
+        MultiTargetTracker(**kwargs)
