@@ -14,7 +14,7 @@ import typer
 from rich.table import Table
 
 from seawatch import __version__
-from seawatch.cli import geometry_cmds, synth_cmds, tbd_cmds
+from seawatch.cli import geometry_cmds, horizon_cmds, synth_cmds, tbd_cmds
 from seawatch.cli._common import EXIT_FAILED, BadInput, emit_json, err, exit_codes, progress_bar
 
 app = typer.Typer(
@@ -242,6 +242,7 @@ app.command()(geometry_cmds.locate)
 app.command()(geometry_cmds.stereo)
 app.command()(geometry_cmds.calibrate)
 app.command()(tbd_cmds.tbd)
+app.command()(horizon_cmds.horizon)
 app.add_typer(synth_cmds.app, name="synth")
 
 

@@ -1,4 +1,4 @@
-"""The edges of the system: files in and out (camera files, MOT track files; more to come).
+"""The edges of the system: files in and out (video, image folders, camera and MOT files).
 
 Degrees, knots and other display units live here and are converted to SI units and
 radians on the way in (STYLE.md).
@@ -6,5 +6,26 @@ radians on the way in (STYLE.md).
 
 from seawatch.io.camera_file import FORMAT_TAG, camera_to_dict, load_camera, save_camera
 from seawatch.io.mot import read_mot, write_mot
+from seawatch.io.video import (
+    Frame,
+    VideoError,
+    VideoReader,
+    VideoWarning,
+    VideoWriter,
+    read_image,
+)
 
-__all__ = ["FORMAT_TAG", "camera_to_dict", "load_camera", "read_mot", "save_camera", "write_mot"]
+__all__ = [
+    "FORMAT_TAG",
+    "Frame",
+    "VideoError",
+    "VideoReader",
+    "VideoWarning",
+    "VideoWriter",
+    "camera_to_dict",
+    "load_camera",
+    "read_image",
+    "read_mot",
+    "save_camera",
+    "write_mot",
+]

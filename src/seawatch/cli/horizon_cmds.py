@@ -1,0 +1,202 @@
+"""Command function of the horizon stage: ``seawatch horizon SOURCE``.
+
+A plain typer-compatible function (the CLI registers it with ``app.command()(horizon)``).
+It reads frames with :class:`seawatch.io.video.VideoReader`, detects the horizon with
+:func:`seawatch.vision.horizon.detect_horizon` (smoothed over time by
+:class:`seawatch.vision.horizon.HorizonTracker` for video) and prints or writes one
+record per frame, in the shape of INTERFACES.md ("Horizon JSON"):
+
+    {"frames": [{"index": 0, "time": 0.0, "found": true, "x0": 0, "y0": 512.3,
+                 "x1": 1919, "y1": 498.7, "confidence": 0.93}, ...]}
+
+(plus ``"file"`` for images from a folder). When the horizon is not found, ``y0`` and
+``y1`` are null. ``-o FILE.csv`` writes the same records as CSV rows (``index, file,
+time, found, x0, y0, x1, y1, confidence``; empty cells for null), each row as soon as
+its frame is done, so a crash or a dropped stream keeps the frames before it.
+
+Exit codes: 0 ok; 2 bad input (a missing or undecodable source, an empty folder, a
+source without frames, a bad option), with a message naming the input — if frames were
+processed before the failure, they are kept in the CSV and printed (``--json``) with an
+``"error"`` entry; 1 for any other failure. Warnings (corrupt frames skipped, a size
+change, a dropped stream, non-image files in a folder) go to stderr.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import sys
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Annotated, Any, TextIO
+
+import typer
+from rich.markup import escape
+
+from seawatch.cli._common import BadInput, emit_json, err, exit_codes, progress_bar
+
+__all__ = ["horizon"]
+
+CSV_COLUMNS = ("index", "file", "time", "found", "x0", "y0", "x1", "y1", "confidence")
+
+
+@contextmanager
+def _warnings_to_stderr() -> Iterator[None]:
+    """Show each warning at once as one line on stderr (not Python's two-line form)."""
+    previous = warnings.showwarning
+
+    def show(message: Warning | str, category: type[Warning], *args: Any, **kw: Any) -> None:
+        err.print(f"[yellow]warning:[/] {escape(str(message))}")
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        warnings.showwarning = show
+        try:
+            yield
+        finally:
+            warnings.showwarning = previous
+
+
+def _record(frame: Any, est: Any) -> dict[str, Any]:
+    rec: dict[str, Any] = {"index": int(frame.index), "time": round(float(frame.time), 6)}
+    if frame.file is not None:
+        rec["file"] = str(frame.file)
+    rec["found"] = bool(est.found)
+    rec["x0"] = 0
+    rec["y0"] = round(est.y0, 2) if est.found else None
+    rec["x1"] = int(est.width - 1)
+    rec["y1"] = round(est.y1, 2) if est.found else None
+    rec["confidence"] = round(float(est.confidence), 3)
+    return rec
+
+
+def _csv_row(rec: dict[str, Any]) -> list[str]:
+    def cell(v: Any) -> str:
+        if v is None:
+            return ""
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, float) and not math.isfinite(v):
+            return ""
+        return str(v)
+
+    return [cell(rec.get(col)) for col in CSV_COLUMNS]
+
+
+def horizon(
+    source: Annotated[
+        str,
+        typer.Argument(
+            help="Video file, image file, image folder, stream URL (rtsp://, http://) "
+            "or camera (0, /dev/video0)."
+        ),
+    ],
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print the horizon JSON on stdout.")
+    ] = False,
+    output: Annotated[
+        Path | None,
+        typer.Option("--output", "-o", help="CSV file, one row per frame, written as it goes."),
+    ] = None,
+    step: Annotated[int, typer.Option(help="Use every STEP-th frame.", min=1)] = 1,
+    fps: Annotated[
+        float | None,
+        typer.Option(help="Frame rate of an image folder (times = index / fps); default 1."),
+    ] = None,
+    start: Annotated[float, typer.Option(help="First time to process [s].", min=0.0)] = 0.0,
+    end: Annotated[
+        float | None, typer.Option(help="Time to stop at [s] (exclusive).", min=0.0)
+    ] = None,
+    max_frames: Annotated[
+        int | None, typer.Option("--max-frames", help="Stop after this many frames.", min=1)
+    ] = None,
+    smooth: Annotated[
+        bool | None,
+        typer.Option(
+            "--smooth/--no-smooth",
+            help="Temporal smoothing (Kalman filter); default on for video, off for images.",
+        ),
+    ] = None,
+    max_tilt: Annotated[
+        float,
+        typer.Option("--max-tilt", help="Largest tilt of the horizon [deg].", min=1.0, max=60.0),
+    ] = 25.0,
+) -> None:
+    """Detect the sea horizon in every frame of a video, stream or image folder.
+
+    Prints (or writes with [bold]-o[/]) the line through (x0, y0) and (x1, y1) at the left
+    and right image borders (pixels, x right, y down), whether it was found, and a
+    confidence in [0, 1]. Video is smoothed over time unless [bold]--no-smooth[/].
+
+    Example: [cyan]seawatch horizon clip.mp4 --json -o horizon.csv[/]
+    """
+    from seawatch.io.video import VideoError, VideoReader
+    from seawatch.vision.horizon import HorizonTracker, detect_horizon
+
+    with exit_codes(), _warnings_to_stderr():
+        if end is not None and end <= start:
+            raise BadInput(f"--end: must be after --start ({start} s), got {end} s")
+        reader = VideoReader(
+            source, step=step, start=start, end=end, max_frames=max_frames, fps=fps
+        )
+        use_tracker = (reader.kind not in ("folder", "image")) if smooth is None else smooth
+        tracker = HorizonTracker(max_tilt_deg=max_tilt, fps=reader.fps or 25.0)
+        records: list[dict[str, Any]] = []
+        sink: TextIO | None = None
+        writer = None
+        if output is not None:
+            try:
+                sink = output.open("w", newline="", encoding="utf-8")
+            except OSError as exc:
+                raise BadInput(f"--output {output}: cannot write ({exc.strerror})") from None
+            writer = csv.writer(sink)
+            writer.writerow(CSV_COLUMNS)
+            sink.flush()
+        total = reader.frame_count
+        if total is not None:
+            total = max(1, math.ceil(total / step))
+            if max_frames is not None:
+                total = min(total, max_frames)
+        failure: Exception | None = None
+        try:
+            with progress_bar() as bar:
+                task = bar.add_task(f"horizon {Path(source).name or source}", total=total)
+                try:
+                    for frame in reader:
+                        if use_tracker:
+                            est = tracker.update(frame.image, frame.time)
+                        else:
+                            est = detect_horizon(frame.image, max_tilt_deg=max_tilt)
+                        rec = _record(frame, est)
+                        records.append(rec)
+                        if writer is not None and sink is not None:
+                            writer.writerow(_csv_row(rec))
+                            sink.flush()
+                        bar.advance(task)
+                except VideoError as exc:
+                    if not records:
+                        raise
+                    failure = exc
+        finally:
+            if sink is not None:
+                sink.close()
+        found = sum(r["found"] for r in records)
+        err.print(
+            f"{len(records)} frame(s), horizon found in {found}"
+            + (f", {reader.skipped} corrupt frame(s) skipped" if reader.skipped else "")
+            + (f"; wrote {output}" if output is not None else "")
+        )
+        if json_out:
+            doc: dict[str, Any] = {"frames": records}
+            if failure is not None:
+                doc["error"] = str(failure)
+            emit_json(doc)
+        elif output is None:
+            for rec in records:
+                y = "not found" if not rec["found"] else f"y0={rec['y0']:.1f} y1={rec['y1']:.1f}"
+                label = rec.get("file", f"t={rec['time']:.3f}s")
+                sys.stdout.write(f"{rec['index']:6d} {label}  {y}  conf={rec['confidence']:.2f}\n")
+        if failure is not None:
+            raise failure
