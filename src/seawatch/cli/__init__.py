@@ -14,7 +14,7 @@ import typer
 from rich.table import Table
 
 from seawatch import __version__
-from seawatch.cli import geometry_cmds, horizon_cmds, synth_cmds, tbd_cmds
+from seawatch.cli import detect_cmds, geometry_cmds, horizon_cmds, synth_cmds, tbd_cmds
 from seawatch.cli._common import EXIT_FAILED, BadInput, emit_json, err, exit_codes, progress_bar
 
 app = typer.Typer(
@@ -243,6 +243,7 @@ app.command()(geometry_cmds.stereo)
 app.command()(geometry_cmds.calibrate)
 app.command()(tbd_cmds.tbd)
 app.command()(horizon_cmds.horizon)
+app.command()(detect_cmds.detect)
 app.add_typer(synth_cmds.app, name="synth")
 
 

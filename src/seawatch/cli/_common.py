@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import math
 import sys
+import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -66,6 +67,23 @@ def exit_codes() -> Iterator[None]:
     except Exception as exc:  # any other failure is ours, not the user's input
         err.print(f"[bold red]failed:[/] {type(exc).__name__}: {escape(str(exc))}")
         raise typer.Exit(EXIT_FAILED) from None
+
+
+@contextmanager
+def warnings_to_stderr() -> Iterator[None]:
+    """Show each warning at once as one line on stderr (not Python's two-line form)."""
+    previous = warnings.showwarning
+
+    def show(message: Warning | str, category: type[Warning], *args: Any, **kw: Any) -> None:
+        err.print(f"[yellow]warning:[/] {escape(str(message))}")
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        warnings.showwarning = show
+        try:
+            yield
+        finally:
+            warnings.showwarning = previous
 
 
 def progress_bar() -> Progress:

@@ -26,37 +26,23 @@ from __future__ import annotations
 import csv
 import math
 import sys
-import warnings
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Any, TextIO
 
 import typer
-from rich.markup import escape
 
-from seawatch.cli._common import BadInput, emit_json, err, exit_codes, progress_bar
+from seawatch.cli._common import (
+    BadInput,
+    emit_json,
+    err,
+    exit_codes,
+    progress_bar,
+    warnings_to_stderr,
+)
 
 __all__ = ["horizon"]
 
 CSV_COLUMNS = ("index", "file", "time", "found", "x0", "y0", "x1", "y1", "confidence")
-
-
-@contextmanager
-def _warnings_to_stderr() -> Iterator[None]:
-    """Show each warning at once as one line on stderr (not Python's two-line form)."""
-    previous = warnings.showwarning
-
-    def show(message: Warning | str, category: type[Warning], *args: Any, **kw: Any) -> None:
-        err.print(f"[yellow]warning:[/] {escape(str(message))}")
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("always")
-        warnings.showwarning = show
-        try:
-            yield
-        finally:
-            warnings.showwarning = previous
 
 
 def _record(frame: Any, est: Any) -> dict[str, Any]:
@@ -135,7 +121,7 @@ def horizon(
     from seawatch.io.video import VideoError, VideoReader
     from seawatch.vision.horizon import HorizonTracker, detect_horizon
 
-    with exit_codes(), _warnings_to_stderr():
+    with exit_codes(), warnings_to_stderr():
         if end is not None and end <= start:
             raise BadInput(f"--end: must be after --start ({start} s), got {end} s")
         reader = VideoReader(

@@ -7,8 +7,19 @@
   (row, col, intensity, area).
 * :mod:`seawatch.vision.horizon` — the sea horizon per frame (``detect_horizon``), its
   temporal smoothing (``HorizonTracker``) and the sea region below it (``sea_mask``).
+* :mod:`seawatch.vision.detect` — ship boxes with their water-line points: the classical
+  weight-free ``ClassicalShipDetector``, ``OnnxDetector`` (optional onnxruntime) and
+  ``CallableDetector`` for a user's own function.
 """
 
+from seawatch.vision.detect import (
+    DETECTION_COLUMNS,
+    CallableDetector,
+    ClassicalShipDetector,
+    Detections,
+    Detector,
+    OnnxDetector,
+)
 from seawatch.vision.horizon import HorizonEstimate, HorizonTracker, detect_horizon, sea_mask
 from seawatch.vision.marks import (
     MARK_COLUMNS,
@@ -20,9 +31,15 @@ from seawatch.vision.marks import (
 )
 
 __all__ = [
+    "DETECTION_COLUMNS",
     "MARK_COLUMNS",
+    "CallableDetector",
+    "ClassicalShipDetector",
+    "Detections",
+    "Detector",
     "HorizonEstimate",
     "HorizonTracker",
+    "OnnxDetector",
     "adaptive_mask",
     "cfar_mask",
     "detect_horizon",

@@ -1,0 +1,243 @@
+"""Command function of the detection stage: ``seawatch detect SOURCE``.
+
+A plain typer-compatible function (the CLI registers it with ``app.command()(detect)``).
+It reads frames with :class:`seawatch.io.video.VideoReader`, finds the sea region with
+the horizon detector (:class:`seawatch.vision.horizon.HorizonTracker` for video,
+:func:`seawatch.vision.horizon.detect_horizon` for images; ``--no-horizon`` searches the
+whole frame), runs a ship detector (:class:`seawatch.vision.detect.ClassicalShipDetector`,
+or an ONNX model with ``--model``) and prints or writes the boxes of every frame in the
+shape of INTERFACES.md ("Detection JSON"):
+
+    {"frames": [{"index": 0, "time": 0.0, "boxes": [{"x": 412.0, "y": 233.5, "w": 18.0,
+                 "h": 9.0, "score": 0.87, "u_wl": 421.0, "v_wl": 242.5}, ...]}, ...]}
+
+(plus ``"file"`` for images from a folder). ``-o BOXES.csv`` writes one row per box —
+``index, file, time, x, y, w, h, score, u_wl, v_wl`` — each frame's rows as soon as the
+frame is done, so a crash or a dropped stream keeps the frames before it.
+
+Exit codes: 0 ok; 2 bad input (a missing or undecodable source, an empty folder, a
+source without frames, a missing model file, a bad option), with a message naming the
+input — if frames were processed before the failure, they are kept in the CSV and
+printed (``--json``) with an ``"error"`` entry; 1 for any other failure. Warnings
+(corrupt frames skipped, a size change, a dropped stream, non-image files in a folder)
+go to stderr.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import sys
+from pathlib import Path
+from typing import Annotated, Any, TextIO
+
+import typer
+
+from seawatch.cli._common import (
+    BadInput,
+    emit_json,
+    err,
+    exit_codes,
+    progress_bar,
+    warnings_to_stderr,
+)
+
+__all__ = ["CSV_COLUMNS", "detect"]
+
+CSV_COLUMNS = ("index", "file", "time", "x", "y", "w", "h", "score", "u_wl", "v_wl")
+"""Columns of ``-o BOXES.csv`` (INTERFACES.md), one row per box."""
+
+_BOX_KEYS = ("x", "y", "w", "h", "score", "u_wl", "v_wl")
+
+
+def _record(frame: Any, boxes: Any) -> dict[str, Any]:
+    """The Detection-JSON record of one frame."""
+    rec: dict[str, Any] = {"index": int(frame.index), "time": round(float(frame.time), 6)}
+    if frame.file is not None:
+        rec["file"] = str(frame.file)
+    rec["boxes"] = [
+        {k: round(float(v), 3 if k == "score" else 2) for k, v in zip(_BOX_KEYS, row, strict=True)}
+        for row in boxes.boxes
+    ]
+    return rec
+
+
+def _csv_rows(rec: dict[str, Any]) -> list[list[str]]:
+    file = rec.get("file", "")
+    return [
+        [str(rec["index"]), file, str(rec["time"])] + [str(b[k]) for k in _BOX_KEYS]
+        for b in rec["boxes"]
+    ]
+
+
+def detect(
+    source: Annotated[
+        str,
+        typer.Argument(
+            help="Video file, image file, image folder, stream URL (rtsp://, http://) "
+            "or camera (0, /dev/video0)."
+        ),
+    ],
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print the detection JSON on stdout.")
+    ] = False,
+    output: Annotated[
+        Path | None,
+        typer.Option("--output", "-o", help="BOXES.csv, one row per box, written frame by frame."),
+    ] = None,
+    model: Annotated[
+        Path | None,
+        typer.Option(
+            "--model",
+            help="A YOLO-style ONNX model to use instead of the classical detector "
+            "(needs onnxruntime).",
+        ),
+    ] = None,
+    threshold: Annotated[
+        float | None,
+        typer.Option(
+            help="Detection threshold: noise units for the classical detector (default 6), "
+            "a score in [0, 1] for --model (default 0.25).",
+            min=0.0,
+        ),
+    ] = None,
+    use_horizon: Annotated[
+        bool,
+        typer.Option(
+            "--horizon/--no-horizon",
+            help="Look for ships on the sea below the detected horizon (default) or in the "
+            "whole frame.",
+        ),
+    ] = True,
+    temporal: Annotated[
+        bool,
+        typer.Option(
+            "--temporal/--no-temporal",
+            help="Temporal clutter model across frames (suppresses flicker and static "
+            "clutter in video; off by default).",
+        ),
+    ] = False,
+    step: Annotated[int, typer.Option(help="Use every STEP-th frame.", min=1)] = 1,
+    fps: Annotated[
+        float | None,
+        typer.Option(help="Frame rate of an image folder (times = index / fps); default 1."),
+    ] = None,
+    start: Annotated[float, typer.Option(help="First time to process [s].", min=0.0)] = 0.0,
+    end: Annotated[
+        float | None, typer.Option(help="Time to stop at [s] (exclusive).", min=0.0)
+    ] = None,
+    max_frames: Annotated[
+        int | None, typer.Option("--max-frames", help="Stop after this many frames.", min=1)
+    ] = None,
+) -> None:
+    """Detect ships in every frame of a video, stream or image folder.
+
+    Prints (or writes with [bold]-o[/]) each ship's box — top-left corner (x, y), width
+    and height in pixels — its score in [0, 1] and its water-line point (u_wl, v_wl),
+    where the hull meets the water. Ships are searched on the sea below the detected
+    horizon unless [bold]--no-horizon[/].
+
+    Example: [cyan]seawatch detect clip.mp4 --json -o boxes.csv[/]
+    """
+    from seawatch.io.video import VideoError, VideoReader
+    from seawatch.vision.detect import ClassicalShipDetector, OnnxDetector
+
+    with exit_codes(), warnings_to_stderr():
+        if end is not None and end <= start:
+            raise BadInput(f"--end: must be after --start ({start} s), got {end} s")
+        if model is not None:
+            if not model.is_file():
+                raise BadInput(f"--model {model}: no such ONNX model file")
+            if threshold is not None and threshold > 1:
+                raise BadInput(f"--threshold: a model score in [0, 1], got {threshold}")
+            try:
+                detector: Any = OnnxDetector(
+                    model, score_threshold=0.25 if threshold is None else threshold
+                )
+            except ImportError as exc:
+                raise BadInput(f"--model {model}: {exc}") from None
+        else:
+            thr = 6.0 if threshold is None else threshold
+            if not thr > 0:
+                raise BadInput(f"--threshold: expected a number of noise units > 0, got {thr}")
+            detector = ClassicalShipDetector(
+                threshold=thr, grow_threshold=min(3.0, thr), temporal=temporal
+            )
+        reader = VideoReader(
+            source, step=step, start=start, end=end, max_frames=max_frames, fps=fps
+        )
+        horizon_of = _horizon_source(reader, use_horizon)
+        records: list[dict[str, Any]] = []
+        sink: TextIO | None = None
+        writer = None
+        if output is not None:
+            try:
+                sink = output.open("w", newline="", encoding="utf-8")
+            except OSError as exc:
+                raise BadInput(f"--output {output}: cannot write ({exc.strerror})") from None
+            writer = csv.writer(sink)
+            writer.writerow(CSV_COLUMNS)
+            sink.flush()
+        total = reader.frame_count
+        if total is not None:
+            total = max(1, math.ceil(total / step))
+            if max_frames is not None:
+                total = min(total, max_frames)
+        failure: Exception | None = None
+        n_boxes = 0
+        try:
+            with progress_bar() as bar:
+                task = bar.add_task(f"detect {Path(source).name or source}", total=total)
+                try:
+                    for frame in reader:
+                        hz = horizon_of(frame)
+                        boxes = detector(frame.image, horizon=hz)
+                        rec = _record(frame, boxes)
+                        records.append(rec)
+                        n_boxes += len(rec["boxes"])
+                        if writer is not None and sink is not None:
+                            writer.writerows(_csv_rows(rec))
+                            sink.flush()
+                        bar.advance(task)
+                except VideoError as exc:
+                    if not records:
+                        raise
+                    failure = exc
+        finally:
+            if sink is not None:
+                sink.close()
+        err.print(
+            f"{len(records)} frame(s), {n_boxes} box(es)"
+            + (f", {reader.skipped} corrupt frame(s) skipped" if reader.skipped else "")
+            + (f"; wrote {output}" if output is not None else "")
+        )
+        if json_out:
+            doc: dict[str, Any] = {"frames": records}
+            if failure is not None:
+                doc["error"] = str(failure)
+            emit_json(doc)
+        elif output is None:
+            for rec in records:
+                label = rec.get("file", f"t={rec['time']:.3f}s")
+                boxes_txt = "  ".join(
+                    f"[{b['x']:.0f},{b['y']:.0f} {b['w']:.0f}x{b['h']:.0f} {b['score']:.2f}]"
+                    for b in rec["boxes"]
+                )
+                sys.stdout.write(
+                    f"{rec['index']:6d} {label}  {len(rec['boxes'])} box(es)  {boxes_txt}\n"
+                )
+        if failure is not None:
+            raise failure
+
+
+def _horizon_source(reader: Any, use_horizon: bool) -> Any:
+    """A function frame → horizon estimate (or None): tracked over time for video,
+    per image for images and folders, None with ``--no-horizon``."""
+    if not use_horizon:
+        return lambda frame: None
+    from seawatch.vision.horizon import HorizonTracker, detect_horizon
+
+    if reader.kind in ("folder", "image"):
+        return lambda frame: detect_horizon(frame.image)
+    tracker = HorizonTracker(fps=reader.fps or 25.0)
+    return lambda frame: tracker.update(frame.image, frame.time)

@@ -1,0 +1,608 @@
+"""seawatch.vision.detect: classical ship detector, callable and ONNX detectors.
+
+Truths: synthetic sea scenes drawn here with known ship boxes and water lines (textured
+sea with perspective waves and noise, small and large, dark and bright ships with hull
+and superstructure, a sun-glitter patch and a coastline band that must give no boxes,
+camera roll); 88 real thermal frames with a hand-made boat box per frame (MarDCT video
+ir-3 annotated by the TIRSD repository, Apache-2.0; ``../shared/data/mardct_ir3/``, read
+in place); hand-built YOLO output tensors whose boxes are known.
+"""
+
+from __future__ import annotations
+
+import csv
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from seawatch.vision.detect import (
+    DETECTION_COLUMNS,
+    CallableDetector,
+    ClassicalShipDetector,
+    Detections,
+    Detector,
+    OnnxDetector,
+    decode_yolo,
+    sea_region,
+    waterline_points,
+)
+
+MARDCT = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "mardct_ir3"
+needs_mardct = pytest.mark.skipif(
+    not (MARDCT / "boxes.csv").is_file(),
+    reason=f"MarDCT ir-3 frames not found at {MARDCT} (shared data folder absent)",
+)
+
+
+# ------------------------------------------------------------------ synthetic scenes
+
+
+def sea_scene(
+    rng: np.random.Generator,
+    h: int = 360,
+    w: int = 640,
+    horizon: float = 120.0,
+    *,
+    roll_deg: float = 0.0,
+    ships: tuple[dict, ...] | list[dict] = (),
+    glint: tuple[float, float, float, float] | None = None,
+    coast: bool = False,
+    noise: float = 2.0,
+    wave_amp: float = 4.0,
+) -> tuple[np.ndarray, np.ndarray, tuple[float, float, float, float]]:
+    """A grey sky/sea frame (float, grey levels) with known ships.
+
+    Sky brightening away from the horizon with faint clouds; sea darkening towards the
+    bottom with five horizontally elongated wave trains that get finer towards the
+    horizon (perspective); optional coastline band of textured land standing on the
+    horizon (left half) with bright 4×3 px buildings at least 6 px above the line;
+    optional sun glitter: 1–2 px sparkles, dense in the middle of an elliptical patch
+    ``(cx, cy, a, b)``; Gaussian noise. Each ship dict: ``cx, base`` (hull bottom row
+    edge), ``length, height`` (hull), optional ``sup_w, sup_h`` (superstructure) and
+    ``contrast`` (signed, grey levels against the local sea).
+
+    Returns the image, the truth rows ``(x, y, w, h, u_wl, v_wl)`` [px, pixel-centre
+    origin] and the horizon ``(x0, y0, x1, y1)``.
+    """
+    yy, xx = np.mgrid[0:h, 0:w].astype(np.float64)
+    slope = np.tan(np.radians(roll_deg))
+    yh = horizon + (xx - (w - 1) / 2) * slope
+    below = yy - yh
+    t = np.clip(below / (h - horizon), 0, 1)
+    img = np.where(below < 0, 150 + 25 * np.clip(-below / horizon, 0, 1), 90 - 25 * t)
+    img += np.where(below < 0, cv2.GaussianBlur(rng.normal(0, 1, (h, w)), (0, 0), 12) * 60, 0)
+    p = 0.08 + t
+    waves = np.zeros((h, w))
+    for _ in range(5):
+        th = rng.uniform(-0.5, 0.5)
+        lx, ly = rng.uniform(40, 140) * p, rng.uniform(4, 10) * p
+        waves += np.sin(2 * np.pi * (xx * np.sin(th) / lx + below / ly) + rng.uniform(0, 6.3))
+    img += np.where(below >= 0, wave_amp * np.sqrt(p) * waves / np.sqrt(5), 0)
+    if coast:
+        prof = cv2.GaussianBlur(rng.normal(0, 1, (1, w)), (0, 0), 40)[0]
+        prof = np.clip(8 + 22 * np.abs(prof) / 0.05, 6, 40)
+        band = (below < 0) & (below > -prof[None, :])
+        band[:, : int(0.05 * w)] = False
+        band[:, int(0.55 * w) :] = False
+        land = 120 + cv2.GaussianBlur(rng.normal(0, 1, (h, w)), (0, 0), 2) * 40
+        img = np.where(band, land, img)
+        for _ in range(12):
+            bx = int(rng.uniform(0.05 * w + 5, 0.55 * w - 5))
+            by = int(yh[0, bx] - rng.uniform(6, max(7, prof[bx] - 2)))
+            img[by - 1 : by + 2, bx - 2 : bx + 2] = 230
+    truth = []
+    for s in ships:
+        cx, base, length, hh = s["cx"], s["base"], s["length"], s["height"]
+        c0, c1 = round(cx - length / 2), round(cx + length / 2) - 1
+        r1 = round(base) - 1
+        r0 = r1 - hh + 1
+        val = img[r0 : r1 + 1, max(c0 - 30, 0) : c1 + 30].mean() + s["contrast"]
+        for r in range(r0, r1 + 1):  # hull, a little narrower at the bottom
+            inset = round((r - r0) / max(1, hh) * 0.15 * length)
+            img[r, c0 + inset : c1 - inset + 1] = val
+        top, lo, hi = r0, c0, c1
+        if s.get("sup_h", 0):
+            sw, sh = s["sup_w"], s["sup_h"]
+            sc0 = round(cx - sw / 2)
+            top = r0 - sh
+            img[top:r0, sc0 : sc0 + sw] = val + s.get("sup_extra", 0.0)
+            lo, hi = min(c0, sc0), max(c1, sc0 + sw - 1)
+        truth.append((lo - 0.5, top - 0.5, hi - lo + 1, r1 - top + 1, (c0 + c1) / 2, r1 + 0.5))
+    if glint is not None:
+        gx, gy, a, b = glint
+        env = np.exp(-0.5 * (((xx - gx) / a) ** 2 + ((yy - gy) / b) ** 2))
+        sparkle = (rng.random((h, w)) < 0.25 * env) & (below > 2)
+        sparkle |= np.roll(sparkle, 1, axis=1) & (rng.random((h, w)) < 0.5)
+        img += sparkle * rng.uniform(50, 130, (h, w)) * np.sqrt(env)
+    img += rng.normal(0, noise, (h, w))
+    return img, np.array(truth).reshape(-1, 6), (0.0, yh[0, 0], w - 1.0, yh[0, -1])
+
+
+def as_u8(img: np.ndarray) -> np.ndarray:
+    return np.clip(np.round(img), 0, 255).astype(np.uint8)
+
+
+def random_ships(rng: np.random.Generator, h: int, w: int, horizon: float, n: int) -> list:
+    """n non-overlapping ships: half small (6–14 × 3–5 px hulls), half large (30–110 px
+    long with a superstructure), contrast ±15–40 grey levels."""
+    ships: list[dict] = []
+    used: list[tuple[float, float, float, float]] = []
+    for _ in range(n):
+        for _ in range(100):
+            small = rng.random() < 0.5
+            if small:
+                length, hh, sup = int(rng.uniform(6, 14)), int(rng.uniform(3, 5)), (0, 0)
+            else:
+                length = int(rng.uniform(30, 110))
+                hh = int(max(4, length * rng.uniform(0.12, 0.2)))
+                sup = (int(length * rng.uniform(0.2, 0.4)), int(hh * rng.uniform(0.6, 1.2)))
+            base = rng.uniform(horizon + 6 + (0 if small else 20), h - 10)
+            cx = rng.uniform(length / 2 + 20, w - length / 2 - 20)
+            box = (cx - length / 2 - 15, base - hh - sup[1] - 10, cx + length / 2 + 15, base + 10)
+            if all(box[2] < u[0] or u[2] < box[0] or box[3] < u[1] or u[3] < box[1] for u in used):
+                used.append(box)
+                break
+        else:
+            continue
+        ships.append(
+            {
+                "cx": cx,
+                "base": base,
+                "length": length,
+                "height": hh,
+                "sup_w": sup[0],
+                "sup_h": sup[1],
+                "contrast": rng.choice([-1, 1]) * rng.uniform(15, 40),
+                "sup_extra": rng.uniform(-10, 10),
+            }
+        )
+    return ships
+
+
+def match(det: Detections, truth: np.ndarray, tol: float = 12.0) -> tuple[np.ndarray, int]:
+    """Greedy one-to-one matching: a truth is found when an unused detection centre is
+    within max(tol, (w + h)/4) px city-block of the truth box centre. Returns the index
+    of the matching detection per truth (-1 = missed) and the number of false boxes."""
+    centres = det.centers
+    tc = truth[:, :2] + truth[:, 2:4] / 2
+    used = np.zeros(len(det), bool)
+    found = np.full(len(truth), -1)
+    for i in range(len(truth)):
+        if not len(det):
+            break
+        d = np.abs(centres - tc[i]).sum(axis=1)
+        ok = np.flatnonzero((d <= max(tol, 0.25 * (truth[i, 2] + truth[i, 3]))) & ~used)
+        if ok.size:
+            j = ok[np.argmin(d[ok])]
+            used[j] = True
+            found[i] = j
+    return found, int((~used).sum())
+
+
+def fixed_ships() -> list[dict]:
+    """Five well-separated ships: small dark, small bright, tiny (3 px high), large dark
+    with superstructure, large bright with superstructure."""
+    return [
+        {"cx": 100, "base": 170, "length": 12, "height": 4, "contrast": -30},
+        {"cx": 250, "base": 200, "length": 10, "height": 4, "contrast": 30},
+        {"cx": 560, "base": 160, "length": 8, "height": 3, "contrast": -35},
+        {"cx": 420, "base": 300, "length": 90, "height": 14, "sup_w": 30, "sup_h": 12,
+         "contrast": -35},
+        {"cx": 150, "base": 320, "length": 60, "height": 10, "sup_w": 20, "sup_h": 9,
+         "contrast": 30},
+    ]  # fmt: skip
+
+
+# ------------------------------------------------------------------ result type
+
+
+def test_detections_from_boxes_defaults_score_one_and_bottom_centre_waterline():
+    det = Detections.from_boxes([[10, 20, 30, 8], [0, 0, 4, 4]], score=[0.2, 0.9])
+    assert det.boxes.shape == (2, 7)
+    assert list(det.score) == [0.9, 0.2]  # sorted by score
+    np.testing.assert_allclose(det.u_wl, det.x + det.w / 2)
+    np.testing.assert_allclose(det.v_wl, det.y + det.h)
+    rec = det.records()[1]
+    assert tuple(rec) == DETECTION_COLUMNS
+    assert rec["x"] == 10 and rec["v_wl"] == 28
+    with pytest.raises(ValueError, match="boxes"):
+        Detections(np.zeros((2, 6)))
+    with pytest.raises(ValueError, match="score"):
+        Detections(np.array([[0, 0, 1, 1, 1.5, 0, 0]]))
+    assert len(Detections.empty()) == 0
+
+
+def test_every_detector_satisfies_the_detector_protocol():
+    assert isinstance(ClassicalShipDetector(), Detector)
+    assert isinstance(CallableDetector(lambda im: []), Detector)
+
+
+def test_sea_region_is_the_area_below_the_line():
+    m = sea_region((10, 20), (0, 4.0, 19, 4.0))
+    assert m[4:].all() and not m[:4].any()
+    assert sea_region((5, 5), None).all()
+
+
+# ------------------------------------------------------------------ classical detector
+
+
+def test_finds_small_large_dark_and_bright_ships_with_their_water_lines():
+    rng = np.random.default_rng(1234)
+    img, truth, hz = sea_scene(rng, ships=fixed_ships(), coast=True)
+    det = ClassicalShipDetector()(as_u8(img), horizon=hz)
+    found, n_false = match(det, truth)
+    assert (found >= 0).all(), f"missed {truth[found < 0]}"
+    assert n_false == 0
+    assert ((det.score > 0) & (det.score <= 1)).all()
+    for i, j in enumerate(found[:4]):
+        # water line: the hull's bottom edge, near the hull's centre column; the box
+        # holds the superstructure
+        assert abs(det.v_wl[j] - truth[i, 5]) <= 1.5
+        assert abs(det.u_wl[j] - truth[i, 4]) <= max(2.0, truth[i, 2] / 8)
+        assert det.y[j] <= truth[i, 1] + 2
+    # Known limit: the 60 px bright hull (+30 grey levels over 4-level waves) is wider
+    # than the finest scale's guard window, and at the coarser scale its own CFAR shadow
+    # raises the noise estimate; only its superstructure (20 × 9 px) is boxed.
+    j = found[4]
+    assert truth[4, 0] <= det.x[j] and det.x[j] + det.w[j] <= truth[4, 0] + truth[4, 2]
+
+
+def test_random_scenes_recall_and_false_boxes_per_frame():
+    """Seeded random scenes (5 ships, glitter patch, coastline, roll up to ±3°): recall
+    ≥ 0.75 and at most 0.5 false boxes per frame (measured 0.83 and 0.20 on 20 scenes;
+    the misses are ships inside the glitter and large ones hugging the horizon)."""
+    rng = np.random.default_rng(1234)
+    det = ClassicalShipDetector()
+    hits = total = false = 0
+    n = 12
+    for _ in range(n):
+        hz = 360 * rng.uniform(0.25, 0.4)
+        ships = random_ships(rng, 360, 640, hz, 5)
+        glint = (rng.uniform(0.3, 0.7) * 640, hz + rng.uniform(0.2, 0.4) * (360 - hz), 60, 15)
+        img, truth, line = sea_scene(
+            rng, horizon=hz, roll_deg=rng.uniform(-3, 3), ships=ships, glint=glint, coast=True
+        )
+        found, n_false = match(det(as_u8(img), horizon=line), truth)
+        hits += int((found >= 0).sum())
+        total += len(truth)
+        false += n_false
+    assert hits / total >= 0.75
+    assert false / n <= 0.5
+
+
+def test_glitter_patch_and_coastline_give_no_boxes():
+    rng = np.random.default_rng(7)
+    img, _, hz = sea_scene(rng, glint=(320, 220, 70, 18), coast=True)
+    det = ClassicalShipDetector()(as_u8(img), horizon=hz)
+    assert len(det) == 0, det.boxes
+
+
+def test_land_above_the_horizon_is_ignored_but_found_without_a_horizon():
+    rng = np.random.default_rng(3)
+    img, _, hz = sea_scene(rng, coast=True, noise=1.0)
+    u8 = as_u8(img)
+    assert len(ClassicalShipDetector()(u8, horizon=hz)) == 0
+    # the bright buildings on the land band are targets when the sea region is unknown
+    everywhere = ClassicalShipDetector()(u8)
+    assert len(everywhere) >= 1
+    assert (everywhere.v_wl < hz[1]).all()
+
+
+def test_ship_rising_above_the_horizon_keeps_its_superstructure():
+    rng = np.random.default_rng(5)
+    ship = {"cx": 300, "base": 126, "length": 40, "height": 5, "sup_w": 14, "sup_h": 12,
+            "contrast": -40}  # fmt: skip
+    img, truth, hz = sea_scene(rng, ships=[ship], noise=1.0)
+    det = ClassicalShipDetector()(as_u8(img), horizon=hz)
+    found, n_false = match(det, truth)
+    assert found[0] >= 0 and n_false == 0
+    assert det.y[found[0]] < hz[1] - 5  # the box reaches above the horizon line
+
+
+def test_tiny_ship_three_pixels_high_is_found_in_a_1080p_frame():
+    rng = np.random.default_rng(11)
+    ship = {"cx": 1200, "base": 520, "length": 9, "height": 3, "contrast": -30}
+    img, truth, hz = sea_scene(rng, 1080, 1920, 450.0, ships=[ship], noise=2.0)
+    det = ClassicalShipDetector()(as_u8(img), horizon=hz)
+    found, n_false = match(det, truth)
+    assert found[0] >= 0 and n_false == 0
+
+
+def test_sixteen_bit_thermal_frame_gives_the_same_ships_as_eight_bit():
+    rng = np.random.default_rng(1234)
+    img, truth, hz = sea_scene(rng, ships=fixed_ships())
+    u8 = as_u8(img)
+    u16 = (u8.astype(np.uint16) * 40 + 3000).astype(np.uint16)
+    a = ClassicalShipDetector()(u8, horizon=hz)
+    b = ClassicalShipDetector()(u16, horizon=hz)
+    assert len(a) == len(b) == len(truth)
+    order_a, order_b = np.argsort(a.x), np.argsort(b.x)
+    np.testing.assert_allclose(a.boxes[order_a][:, :4], b.boxes[order_b][:, :4], atol=1.0)
+
+
+def test_colour_boat_as_bright_as_the_sea_is_found_by_its_chroma():
+    rng = np.random.default_rng(2)
+    img, _, hz = sea_scene(rng, noise=1.0)
+    grey = as_u8(img)
+    bgr = np.dstack([grey, grey, grey]).astype(np.float64)
+    # an orange hull of the sea's own luma: 0.299 R + 0.587 G + 0.114 B unchanged
+    r0, r1, c0, c1 = 196, 200, 300, 312
+    luma = bgr[r0:r1, c0:c1, 0].copy()
+    bgr[r0:r1, c0:c1, 2] = luma + 40  # R
+    bgr[r0:r1, c0:c1, 1] = luma - 40 * 0.299 / 0.587  # G
+    bgr[r0:r1, c0:c1, 0] = luma  # B
+    bgr = as_u8(bgr)
+    truth = np.array([[c0 - 0.5, r0 - 0.5, c1 - c0, r1 - r0, (c0 + c1 - 1) / 2, r1 - 0.5]])
+    found, n_false = match(ClassicalShipDetector()(bgr, horizon=hz), truth)
+    assert found[0] >= 0 and n_false == 0
+    found, _ = match(ClassicalShipDetector(colour=False)(bgr, horizon=hz), truth)
+    assert found[0] < 0  # the luma alone does not show it
+
+
+def test_sea_mask_restricts_boxes_to_the_sea():
+    rng = np.random.default_rng(1234)
+    img, truth, _ = sea_scene(rng, ships=fixed_ships())
+    mask = np.zeros(img.shape, bool)
+    mask[130:, :320] = True  # only the left half of the sea
+    det = ClassicalShipDetector()(as_u8(img), sea_mask=mask)
+    found, n_false = match(det, truth)
+    left = truth[:, 4] < 320
+    assert (found[left] >= 0).all() and (found[~left] < 0).all() and n_false == 0
+
+
+def test_temporal_model_fades_a_static_hot_spot_but_keeps_a_moving_ship():
+    rng = np.random.default_rng(4)
+    base_img, _, _ = sea_scene(rng, 240, 320, 60.0, wave_amp=0.0, noise=0.0)
+    det_t = ClassicalShipDetector(temporal=True, temporal_rate=1.0)  # learns in ~100 frames
+    det_0 = ClassicalShipDetector()
+    hot = (150, 80)  # fixed-pattern hot spot (row, col), 3×3 px
+    for k in range(120):
+        img = base_img + rng.normal(0, 2.0, base_img.shape)
+        img[hot[0] - 1 : hot[0] + 2, hot[1] - 1 : hot[1] + 2] += 40
+        c = 20 + 2 * k  # a dark ship moving 2 px per frame
+        img[186:191, c : c + 14] -= 35
+        u8 = as_u8(img)
+        a = det_t(u8)
+    b = det_0(u8)
+    truth_hot = np.array([[hot[1] - 1.5, hot[0] - 1.5, 3, 3, hot[1], hot[0] + 1.5]])
+    truth_ship = np.array([[c - 0.5, 185.5, 14, 5, c + 6.5, 190.5]])
+    assert match(b, truth_hot)[0][0] >= 0  # frame by frame the hot spot is a target
+    assert match(a, truth_hot)[0][0] < 0  # the temporal model has learnt it
+    assert match(a, truth_ship)[0][0] >= 0 and match(b, truth_ship)[0][0] >= 0
+    det_t.reset()
+    assert match(det_t(u8), truth_hot)[0][0] >= 0
+
+
+def test_temporal_model_keeps_a_ship_that_stays_put_at_the_default_rate():
+    rng = np.random.default_rng(6)
+    base_img, _, _ = sea_scene(rng, 240, 320, 60.0, wave_amp=0.0, noise=0.0)
+    det = ClassicalShipDetector(temporal=True)
+    truth = np.array([[99.5, 185.5, 14, 5, 106.5, 190.5]])
+    for _ in range(150):  # 6 s at 25 frames/s, static camera, anchored ship
+        img = base_img + rng.normal(0, 2.0, base_img.shape)
+        img[186:191, 100:114] -= 35
+        boxes = det(as_u8(img))
+    found, n_false = match(boxes, truth)
+    assert found[0] >= 0 and n_false == 0
+
+
+@pytest.mark.parametrize("value", [0, 255])
+def test_all_black_or_all_white_frame_gives_no_boxes(value):
+    frame = np.full((480, 640, 3), value, np.uint8)
+    assert len(ClassicalShipDetector()(frame)) == 0
+    assert len(ClassicalShipDetector()(frame, horizon=(0, 200, 639, 200))) == 0
+    assert len(ClassicalShipDetector()(np.full((64, 64), float(value)))) == 0
+
+
+def test_horizon_not_found_or_off_the_image_is_handled():
+    rng = np.random.default_rng(1234)
+    img, truth, _ = sea_scene(rng, ships=fixed_ships())
+
+    class NotFound:
+        found, x0, y0, x1, y1, confidence = False, 0.0, 0.0, 639.0, 0.0, 0.1
+
+    assert len(ClassicalShipDetector()(as_u8(img), horizon=NotFound())) >= len(truth)
+    assert len(ClassicalShipDetector()(as_u8(img), horizon=(0, 500, 639, 500))) == 0
+    assert len(ClassicalShipDetector()(as_u8(img), sea_mask=np.zeros(img.shape, bool))) == 0
+
+
+@pytest.mark.parametrize(
+    "image",
+    [
+        np.zeros((32, 32, 2), np.uint8),
+        np.zeros(32, np.uint8),
+        np.zeros((4, 4), np.uint8),
+        np.zeros((32, 32), complex),
+        np.full((32, 32), np.nan),
+    ],
+)
+def test_bad_image_raises_value_error_naming_image(image):
+    with pytest.raises(ValueError, match="image"):
+        ClassicalShipDetector()(image)
+
+
+def test_bad_mask_horizon_and_options_raise_value_error_naming_them():
+    img = np.zeros((64, 64), np.uint8)
+    with pytest.raises(ValueError, match="sea_mask"):
+        ClassicalShipDetector()(img, sea_mask=np.ones((10, 10), bool))
+    with pytest.raises(ValueError, match="horizon"):
+        ClassicalShipDetector()(img, horizon=(0, 1, 0, 5))
+    with pytest.raises(ValueError, match="horizon"):
+        ClassicalShipDetector()(img, horizon="left")
+    for kw, name in [
+        ({"threshold": -1}, "threshold"),
+        ({"threshold": 4, "grow_threshold": 5}, "grow_threshold"),
+        ({"polarity": "up"}, "polarity"),
+        ({"levels": 0}, "levels"),
+        ({"max_size": 2}, "max_size"),
+        ({"max_aspect": (0.5, 2)}, "max_aspect"),
+        ({"temporal_rate": 0}, "temporal_rate"),
+    ]:
+        with pytest.raises(ValueError, match=name):
+            ClassicalShipDetector(**kw)
+
+
+# ------------------------------------------------------------------ real thermal frames
+
+
+@needs_mardct
+def test_mardct_thermal_boat_recall_at_least_0_9_with_at_most_half_a_false_box_per_frame():
+    """Issue 6 target on real pixels: a detection centre within 12 px (city block) of the
+    annotated box centre in ≥ 90 % of the 88 frames, ≤ 0.5 false boxes per frame. The
+    sea region comes from the horizon detector (the sea–land boundary here)."""
+    from seawatch.vision.horizon import detect_horizon
+
+    rows = sorted(csv.DictReader((MARDCT / "boxes.csv").open()), key=lambda r: int(r["frame"]))
+    det = ClassicalShipDetector()
+    hits = false = 0
+    for r in rows:
+        img = cv2.imread(str(MARDCT / "images" / r["file"]), cv2.IMREAD_UNCHANGED)
+        boxes = det(img, horizon=detect_horizon(img))
+        x, y, w, h = (float(r[k]) for k in "xywh")
+        d = np.abs(boxes.centers - [x + w / 2, y + h / 2]).sum(axis=1)
+        hits += bool((d <= 12).any())
+        false += int((d > 12).sum())
+    assert hits / len(rows) >= 0.9
+    assert false / len(rows) <= 0.5
+
+
+# ------------------------------------------------------------------ callable detector
+
+
+def test_callable_detector_fills_scores_and_refines_the_water_line():
+    rng = np.random.default_rng(1234)
+    ship = {"cx": 300, "base": 220, "length": 40, "height": 8, "contrast": -40}
+    img, truth, _ = sea_scene(rng, ships=[ship], noise=1.0)
+    u8 = as_u8(img)
+    x, y, w, h = truth[0, :4]
+    loose = [[x - 3, y - 3, w + 6, h + 9]]  # a user box with slack below the hull
+    det = CallableDetector(lambda im: np.array(loose))(u8)
+    assert len(det) == 1 and det.score[0] == 1.0
+    assert abs(det.v_wl[0] - truth[0, 5]) <= 1.0  # at the hull bottom, not the box bottom
+    np.testing.assert_allclose(waterline_points(u8, loose)[0], det.boxes[0, 5:], atol=1e-9)
+    plain = CallableDetector(lambda im: np.array(loose), refine_waterline=False)(u8)
+    assert plain.v_wl[0] == pytest.approx(y - 3 + h + 9)
+
+
+def test_callable_detector_accepts_dicts_passes_keywords_and_filters_off_sea_boxes():
+    seen = {}
+
+    def fn(image, *, sea_mask=None, horizon=None):
+        seen["horizon"] = horizon
+        return [
+            {"x": 10, "y": 30, "w": 8, "h": 4, "score": 0.7, "u_wl": 14, "v_wl": 34},
+            {"x": 10, "y": 2, "w": 8, "h": 4, "score": 0.9, "u_wl": 14, "v_wl": 6},
+        ]
+
+    img = np.full((64, 64), 100, np.uint8)
+    det = CallableDetector(fn)(img, horizon=(0, 20, 63, 20))
+    assert seen["horizon"] == (0, 20, 63, 20)
+    assert len(det) == 1 and det.score[0] == pytest.approx(0.7)
+    assert len(CallableDetector(fn, filter_sea=False)(img, horizon=(0, 20, 63, 20))) == 2
+
+
+def test_callable_detector_rejects_bad_results_and_non_callables():
+    img = np.full((64, 64), 100, np.uint8)
+    with pytest.raises(ValueError, match="fn's result"):
+        CallableDetector(lambda im: np.zeros((2, 3)))(img)
+    with pytest.raises(ValueError, match="fn's result"):
+        CallableDetector(lambda im: [{"x": 1}])(img)
+    with pytest.raises(ValueError, match="fn"):
+        CallableDetector(42)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="image"):
+        CallableDetector(lambda im: [])(np.zeros((3, 3, 3, 3)))
+    assert len(CallableDetector(lambda im: None)(img)) == 0
+
+
+# ------------------------------------------------------------------ YOLO decoding / ONNX
+
+
+def _yolov8_output(boxes_cxcywh, class_scores, anchors: int = 50) -> np.ndarray:
+    """A (1, 4 + nc, A) tensor holding the given boxes first, zeros elsewhere."""
+    nc = class_scores.shape[1]
+    out = np.zeros((1, 4 + nc, anchors), np.float32)
+    out[0, :4, : len(boxes_cxcywh)] = np.asarray(boxes_cxcywh).T
+    out[0, 4:, : len(boxes_cxcywh)] = class_scores.T
+    return out
+
+
+def test_decode_yolov8_keeps_the_best_of_overlapping_boxes_and_filters_classes():
+    boxes = [[100, 100, 40, 20], [102, 101, 40, 20], [300, 200, 10, 6], [50, 50, 8, 8]]
+    scores = np.array([[0.1, 0.9], [0.2, 0.6], [0.05, 0.8], [0.7, 0.1]])
+    xyxy, s, cls = decode_yolo(_yolov8_output(boxes, scores), score_threshold=0.5)
+    np.testing.assert_allclose(s, [0.9, 0.8, 0.7], rtol=1e-6)
+    np.testing.assert_allclose(xyxy[0], [80, 90, 120, 110])
+    assert list(cls) == [1, 1, 0]
+    xyxy, s, cls = decode_yolo(_yolov8_output(boxes, scores), classes=[1], iou_threshold=0.95)
+    assert list(cls) == [1, 1, 1] and len(s) == 3  # the near-duplicate survives a loose NMS
+
+
+def test_decode_yolov5_multiplies_objectness_and_class_probability():
+    rows = np.zeros((1, 30, 7), np.float32)
+    rows[0, 0] = [50, 60, 10, 4, 0.8, 0.5, 0.9]
+    rows[0, 1] = [10, 10, 4, 4, 0.2, 0.9, 0.1]
+    xyxy, s, cls = decode_yolo(rows, layout="yolov5", score_threshold=0.3)
+    assert len(s) == 1 and s[0] == pytest.approx(0.72) and cls[0] == 1
+    np.testing.assert_allclose(xyxy[0], [45, 58, 55, 62])
+
+
+def test_decode_end2end_and_bad_tensors():
+    e2e = np.array([[[1, 2, 11, 8, 0.9, 8], [0, 0, 5, 5, 0.1, 8]]], np.float32)
+    xyxy, s, cls = decode_yolo(e2e, layout="end2end")
+    assert len(s) == 1 and cls[0] == 8
+    np.testing.assert_allclose(xyxy[0], [1, 2, 11, 8])
+    with pytest.raises(ValueError, match="output"):
+        decode_yolo(np.zeros((2, 3, 4, 5)))
+    with pytest.raises(ValueError, match="layout"):
+        decode_yolo(np.zeros((6, 10)), layout="ssd")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="output"):
+        decode_yolo(np.zeros((10, 5)), layout="end2end")
+
+
+def test_onnx_detector_needs_an_existing_model_and_says_how_to_get_onnxruntime(
+    tmp_path, monkeypatch
+):
+    with pytest.raises(FileNotFoundError, match="model_path"):
+        OnnxDetector(tmp_path / "missing.onnx")
+    model = tmp_path / "m.onnx"
+    model.write_bytes(b"not really a model")
+    monkeypatch.setitem(sys.modules, "onnxruntime", None)  # as if not installed
+    with pytest.raises(ImportError, match="pip install onnxruntime"):
+        OnnxDetector(model)
+
+
+def test_onnx_detector_maps_model_boxes_back_through_the_letterbox(tmp_path):
+    pytest.importorskip("onnxruntime", reason="onnxruntime not installed (optional extra)")
+    onnx = pytest.importorskip("onnx", reason="onnx not installed (needed to build a model)")
+    from onnx import TensorProto, helper, numpy_helper
+
+    # a model whose output is a fixed YOLOv8 tensor (plus 0 × the mean of its input)
+    boxes = [[320, 320, 64, 32]]  # one box at the centre of the 640×640 input
+    const = _yolov8_output(boxes, np.array([[0.9]]), anchors=8)
+    nodes = [
+        helper.make_node("ReduceMean", ["images"], ["m"], keepdims=1),
+        helper.make_node("Mul", ["m", "zero"], ["z"]),
+        helper.make_node("Add", ["z", "const"], ["output0"]),
+    ]
+    graph = helper.make_graph(
+        nodes,
+        "fixed",
+        [helper.make_tensor_value_info("images", TensorProto.FLOAT, [1, 3, 640, 640])],
+        [helper.make_tensor_value_info("output0", TensorProto.FLOAT, list(const.shape))],
+        [
+            numpy_helper.from_array(np.zeros((1, 1, 1, 1), np.float32), "zero"),
+            numpy_helper.from_array(const, "const"),
+        ],
+    )
+    model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", 13)])
+    path = tmp_path / "fixed.onnx"
+    onnx.save(model, str(path))
+    det = OnnxDetector(path, refine_waterline=False)
+    frame = np.full((360, 640, 3), 100, np.uint8)  # letterboxed: scale 1, 140 px bars
+    out = det(frame)
+    assert len(out) == 1 and out.score[0] == pytest.approx(0.9)
+    # input box x 288…352, y 304…336 → frame y 164…196 (minus the 140 px bar)
+    np.testing.assert_allclose(out.boxes[0, :4], [287.5, 163.5, 64, 32], atol=1e-4)
