@@ -83,7 +83,12 @@ def test_experiment_json_has_the_interfaces_shape(tmp_path):
 
 
 @pytest.mark.parametrize(
-    "args", [["experiment", "no-such-paper"], ["experiment", "air-range", "--table", "2"]]
+    "args",
+    [
+        ["experiment", "no-such-paper"],
+        ["experiment", "air-range", "--table", "2"],
+        ["experiment", "air-range", "--fov", "30"],
+    ],
 )
 def test_experiment_bad_name_or_option_is_exit_2(args):
     result = runner.invoke(app, args)

@@ -113,6 +113,22 @@ def experiment(
         str | None,
         typer.Option(help="clutter-tbd: 1, 2, fig4, crossing, splitting or all."),
     ] = None,
+    ais: Annotated[Path | None, typer.Option(help="solent-ais: AIS CSV or NMEA file.")] = None,
+    camera_lat: Annotated[
+        float | None, typer.Option(help="solent-ais: camera latitude (deg).")
+    ] = None,
+    camera_lon: Annotated[
+        float | None, typer.Option(help="solent-ais: camera longitude (deg).")
+    ] = None,
+    camera_height: Annotated[
+        float | None, typer.Option(help="solent-ais: camera height above the sea (m).")
+    ] = None,
+    camera_heading: Annotated[
+        float | None, typer.Option(help="solent-ais: camera heading (deg from North).")
+    ] = None,
+    fov: Annotated[
+        float | None, typer.Option(help="solent-ais: horizontal field of view (deg).")
+    ] = None,
     json_out: Annotated[bool, typer.Option("--json", help="Print the experiment JSON.")] = False,
 ) -> None:
     """Run one of the papers' experiments by name and compare with the paper.
@@ -122,6 +138,8 @@ def experiment(
     INTERFACES.md; ``--out`` writes CSV tables and PNG plots as they are produced.
 
     Example: [cyan]seawatch experiment air-range --runs 100 --out out/air-range[/]
+
+    Example: [cyan]seawatch experiment solent-ais --camera-height 30 --fov 50 --json[/]
     """
     from seawatch.scenarios import registry
 
@@ -130,10 +148,23 @@ def experiment(
         kwargs: dict[str, object] = {"seed": seed, "out_dir": out}
         if runs is not None:
             kwargs["runs"] = runs
-        if table is not None:
-            if "table" not in registry.options(name):
-                raise BadInput(f"--table: experiment {name!r} has no tables to choose from")
-            kwargs["table"] = table
+        scenario_options = {
+            "table": table,
+            "ais": ais,
+            "camera_lat": camera_lat,
+            "camera_lon": camera_lon,
+            "camera_height": camera_height,
+            "camera_heading": camera_heading,
+            "fov": fov,
+        }
+        accepted = registry.options(name)
+        for key, value in scenario_options.items():
+            if value is None:
+                continue
+            if key not in accepted:
+                flag = "--" + key.replace("_", "-")
+                raise BadInput(f"{flag}: experiment {name!r} does not take this option")
+            kwargs[key] = value
         with progress_bar() as bar:
             task = bar.add_task(name, total=None)
             result = run(

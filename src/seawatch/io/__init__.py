@@ -1,9 +1,18 @@
-"""The edges of the system: files in and out (video, image folders, camera and MOT files).
+"""The edges of the system: files in and out (video, camera, AIS, MOT files).
 
 Degrees, knots and other display units live here and are converted to SI units and
 radians on the way in (STYLE.md).
 """
 
+from seawatch.io.ais import (
+    AisTable,
+    AisWarning,
+    interpolate_track,
+    read_ais,
+    read_ais_csv,
+    read_ais_nmea,
+    tracks,
+)
 from seawatch.io.camera_file import FORMAT_TAG, camera_to_dict, load_camera, save_camera
 from seawatch.io.mot import read_mot, write_mot
 from seawatch.io.video import (
@@ -17,15 +26,22 @@ from seawatch.io.video import (
 
 __all__ = [
     "FORMAT_TAG",
+    "AisTable",
+    "AisWarning",
     "Frame",
     "VideoError",
     "VideoReader",
     "VideoWarning",
     "VideoWriter",
     "camera_to_dict",
+    "interpolate_track",
     "load_camera",
+    "read_ais",
+    "read_ais_csv",
+    "read_ais_nmea",
     "read_image",
     "read_mot",
     "save_camera",
+    "tracks",
     "write_mot",
 ]
