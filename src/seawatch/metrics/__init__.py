@@ -3,6 +3,8 @@
 * :mod:`seawatch.metrics.mot` — CLEAR-MOT (MOTA, MOTP, ID switches, FP, FN), identity
   (IDF1, IDP, IDR) and HOTA through TrackEval's metric classes, on pixel boxes (IoU) or
   points (distance): :func:`mot_metrics` for all three at once.
+* :mod:`seawatch.metrics.cle` — the centre location error of visual tracking (§1.6): mean
+  px, percent of the box diagonal, precision at 20 px.
 * :mod:`seawatch.metrics.crlb` — the posterior Cramér–Rao bound (Tichavský recursion in a
   singular-Q-safe form, ALGORITHMS.md §7) for linear models, sea-surface angle
   measurements (uav-sea, solent-ais) and image-size range (air-range).
@@ -10,6 +12,7 @@
   step and over a sequence.
 """
 
+from seawatch.metrics.cle import CLEResult, centre_location_error
 from seawatch.metrics.crlb import (
     PCRBResult,
     air_range_pcrb,
@@ -43,6 +46,7 @@ from seawatch.metrics.ospa import (
 )
 
 __all__ = [
+    "CLEResult",
     "ClearMetrics",
     "GospaResult",
     "GospaSeries",
@@ -52,6 +56,7 @@ __all__ = [
     "PCRBResult",
     "air_range_pcrb",
     "box_iou",
+    "centre_location_error",
     "clear_metrics",
     "curved_sea_range_bound",
     "flat_sea_range_bound",

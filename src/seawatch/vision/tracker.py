@@ -1,0 +1,277 @@
+"""Visual tracking of ship boxes: detector → multi-target tracker → pixel tracks (seed 001).
+
+Issue 6, "Visual tracking"; ALGORITHMS.md §1.3–1.5. Per frame:
+
+1. the horizon (:class:`~seawatch.vision.horizon.HorizonTracker`) and the ship boxes
+   (a :class:`~seawatch.vision.detect.Detector`, by default the
+   :class:`~seawatch.vision.detect.ClassicalShipDetector`) of the frame;
+2. the boxes enter a :class:`~seawatch.tracking.mtt.MultiTargetTracker` (Mahalanobis gate,
+   GNN assignment, M-of-N confirmation): each track's box centre ``[u, v, u_dot, v_dot]``
+   runs the chosen filter —
+
+   * ``"afkf"``: :class:`~seawatch.filters.AdaptiveFractionalKalmanFilter` (§1.5, rule
+     R1, fractional order ``order``, memory ``memory``),
+   * ``"fkf"``: :class:`~seawatch.filters.FractionalKalmanFilter` (§1.4, constant Q),
+   * ``"kf"``: the integer-order Kalman filter (the CV model; §1.3: the FKF at order 1);
+
+   the box size is smoothed exponentially alongside;
+3. confirmed tracks are reported, also while they coast on their prediction through a
+   short occlusion or missed detections (up to ``delete_after`` frames).
+
+The water-line pixel of a track is its box centre plus a smoothed offset from the box
+centre to the detector's water-line point (the bottom-centre of the box until a
+detection gives one).
+
+Track rows: :data:`TRACK_COLUMNS` = ``id, x, y, w, h, u_wl, v_wl, misses`` [–, px, px,
+px, px, px, px, frames]; ``x, y`` is the box's top-left corner.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from seawatch._validation import FloatArray, as_float_array, in_range, positive
+from seawatch.filters import (
+    AdaptiveFractionalKalmanFilter,
+    FractionalKalmanFilter,
+    KalmanFilter,
+)
+from seawatch.tracking.mtt import MultiTargetTracker, TrackStates
+from seawatch.vision.detect import ClassicalShipDetector, Detections
+
+__all__ = ["FILTERS", "TRACK_COLUMNS", "VisualTracker", "tracks_to_rows"]
+
+TRACK_COLUMNS: tuple[str, ...] = ("id", "x", "y", "w", "h", "u_wl", "v_wl", "misses")
+"""Columns of a per-frame track array: track id, box top-left x, y [px], width w and
+height h [px], water-line point u_wl, v_wl [px], consecutive missed detections [frames]."""
+
+FilterName = Literal["afkf", "fkf", "kf"]
+FILTERS: tuple[str, ...] = ("afkf", "fkf", "kf")
+"""The filters :class:`VisualTracker` offers (ship-video estimators of INTERFACES.md)."""
+
+
+def _detection_rows(det: Detections | ArrayLike | None) -> FloatArray:
+    """(k, 7) rows ``x, y, w, h, score, u_wl, v_wl`` from Detections or an array."""
+    if det is None:
+        return np.empty((0, 7))
+    if isinstance(det, Detections):
+        return np.asarray(det.boxes, dtype=np.float64).reshape(-1, 7)
+    arr = as_float_array("detections", det)
+    if arr.size == 0:
+        return np.empty((0, 7))
+    if arr.ndim != 2 or arr.shape[1] not in (4, 5, 7):
+        raise ValueError(
+            "detections: expected boxes (k, 4) as (x, y, w, h), (k, 5) with a score or "
+            f"(k, 7) with the water-line point, got shape {arr.shape}"
+        )
+    out = np.empty((arr.shape[0], 7))
+    out[:, :4] = arr[:, :4]
+    out[:, 4] = arr[:, 4] if arr.shape[1] >= 5 else 1.0
+    if arr.shape[1] == 7:
+        out[:, 5:] = arr[:, 5:]
+    else:  # bottom-centre of the box
+        out[:, 5] = arr[:, 0] + 0.5 * arr[:, 2]
+        out[:, 6] = arr[:, 1] + arr[:, 3]
+    return out
+
+
+class VisualTracker:
+    """Ship boxes per frame → confirmed pixel tracks (module docstring, steps 1–3).
+
+    Args:
+        detector: a detector ``detector(image, horizon=...) -> Detections`` (or boxes);
+            None: :class:`ClassicalShipDetector` with its defaults.
+        filter: ``"afkf"``, ``"fkf"`` or ``"kf"`` (module docstring).
+        order: fractional order alpha of afkf/fkf (ALGORITHMS.md §1.3; default 0.95).
+        memory: GL history length L of afkf/fkf (default 30).
+        sigma_a: acceleration noise of the box centre [px/frame²] (Q0, §1.3).
+        sigma_z: box-centre jitter of the detector [px] (R = σ_z² I).
+        sigma_v0: initial velocity std of a new track [px/frame].
+        gate_probability: gate of the association (χ²₂ probability).
+        confirm_m, confirm_n: M-of-N confirmation.
+        delete_after: consecutive missed frames after which a confirmed track is
+            dropped (the occlusion it survives by prediction).
+        size_smoothing: weight of a new box size in the exponential smoothing, (0, 1].
+        min_score: detections with a lower score are ignored.
+        horizon: estimate the horizon per frame and give it to the detector (sea region).
+        fps: frame rate used when frames come without times [1/s].
+        filter_options: further keyword arguments of the AFKF/FKF (``rule``, ``gain``,
+            ``window``, ``g_max``, ``delta``).
+
+    Time is counted in frames inside the filters (velocities in px/frame, §1.3).
+    """
+
+    def __init__(
+        self,
+        detector: Any = None,
+        filter: FilterName = "afkf",
+        order: float = 0.95,
+        memory: int = 30,
+        *,
+        sigma_a: float = 0.5,
+        sigma_z: float = 2.0,
+        sigma_v0: float = 5.0,
+        gate_probability: float = 0.999,
+        confirm_m: int = 3,
+        confirm_n: int = 5,
+        delete_after: int = 12,
+        size_smoothing: float = 0.3,
+        min_score: float = 0.0,
+        horizon: bool = True,
+        fps: float = 25.0,
+        filter_options: dict[str, Any] | None = None,
+    ) -> None:
+        if filter not in FILTERS:
+            raise ValueError(f"filter: expected one of {', '.join(FILTERS)}, got {filter!r}")
+        if detector is not None and not callable(detector):
+            raise ValueError(f"detector: expected a callable detector, got {detector!r}")
+        self.detector = ClassicalShipDetector() if detector is None else detector
+        self.filter = filter
+        self.order = positive("order", order)
+        if isinstance(memory, bool) or not isinstance(memory, int | np.integer) or memory < 1:
+            raise ValueError(f"memory: expected an integer >= 1, got {memory!r}")
+        self.memory = int(memory)
+        self.min_score = in_range("min_score", min_score, 0.0, 1.0)
+        self.fps = positive("fps", fps)
+        self.use_horizon = bool(horizon)
+        opts = dict(filter_options or {})
+        if filter == "kf":
+            if opts:
+                raise ValueError("filter_options: the Kalman filter takes none")
+            factory: Any = KalmanFilter
+        else:
+            factory = AdaptiveFractionalKalmanFilter if filter == "afkf" else FractionalKalmanFilter
+            opts = {"order": self.order, "memory": self.memory, **opts}
+        self._mtt_args: dict[str, Any] = dict(
+            dt=1.0,
+            sigma_a=sigma_a,
+            sigma_z=sigma_z,
+            sigma_v0=sigma_v0,
+            gate_probability=gate_probability,
+            confirm_m=confirm_m,
+            confirm_n=confirm_n,
+            delete_after=delete_after,
+            size_smoothing=size_smoothing,
+            filter_options=opts or None,
+        )
+        self._factory = factory
+        self.mtt = MultiTargetTracker(factory, **self._mtt_args)
+        self._smooth = float(size_smoothing)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget all tracks, the horizon and the frame count (a new video)."""
+        self.mtt.reset()
+        self._offsets: dict[int, FloatArray] = {}
+        self._frame = 0
+        self._horizon: Any = None
+        if self.use_horizon:
+            from seawatch.vision.horizon import HorizonTracker
+
+            self._horizon = HorizonTracker(fps=self.fps)
+        reset = getattr(self.detector, "reset", None)
+        if callable(reset):
+            reset()
+
+    # ------------------------------------------------------------------ per frame
+    def detect(self, image: ArrayLike, time: float | None = None) -> FloatArray:
+        """Detections (k, 7) ``x, y, w, h, score, u_wl, v_wl`` of one frame (step 1)."""
+        hz = None
+        if self._horizon is not None:
+            hz = self._horizon.update(image, time)
+        try:
+            det = self.detector(image, horizon=hz)
+        except TypeError:
+            det = self.detector(image)
+        return _detection_rows(det)
+
+    def update(self, detections: Detections | ArrayLike | None) -> FloatArray:
+        """Track one frame's detections (steps 2–3); returns the confirmed tracks.
+
+        Args:
+            detections: :class:`Detections`, or boxes (k, 4) ``x, y, w, h`` [px], (k, 5)
+                with a score or (k, 7) with the water-line point; None: no detection.
+
+        Returns:
+            (n, 8) float array of :data:`TRACK_COLUMNS`, rows in order of track id.
+        """
+        rows = _detection_rows(detections)
+        rows = rows[rows[:, 4] >= self.min_score]
+        states = self.mtt.step(rows[:, :4] if rows.shape[0] else None, float(self._frame))
+        self._frame += 1
+        return self._rows(states, rows)
+
+    def step(self, image: ArrayLike, time: float | None = None) -> FloatArray:
+        """Detect and track one frame; the confirmed tracks (:meth:`update`)."""
+        return self.update(self.detect(image, time))
+
+    def track_frames(self, frames: Iterable[Any]) -> list[FloatArray]:
+        """Per-frame confirmed tracks of a frame sequence.
+
+        Args:
+            frames: images (H, W[, C]) or :class:`seawatch.io.video.Frame` objects (their
+                ``time`` feeds the horizon tracker), e.g. a ``VideoReader``.
+
+        Returns:
+            one (n_k, 8) array of :data:`TRACK_COLUMNS` per frame.
+        """
+        out = []
+        for fr in frames:
+            image = getattr(fr, "image", fr)
+            out.append(self.step(image, getattr(fr, "time", None)))
+        return out
+
+    def track_detections(self, detections: Sequence[Any]) -> list[FloatArray]:
+        """Per-frame confirmed tracks of precomputed per-frame detections (no detector).
+
+        Lets several filters run on the very same detections (the ship-video scenario).
+        """
+        return [self.update(d) for d in detections]
+
+    # ------------------------------------------------------------------ output
+    def _rows(self, st: TrackStates, det: FloatArray) -> FloatArray:
+        live = set(int(i) for i in st.ids)
+        for gone in [k for k in self._offsets if k not in live]:
+            del self._offsets[gone]
+        boxes = st.boxes if st.boxes is not None else np.zeros((len(st), 4))
+        centres = st.states[:, :2]
+        for i, tid in enumerate(st.ids):
+            tid = int(tid)
+            j = int(st.detection[i])
+            if j < 0 or j >= det.shape[0]:
+                continue
+            c = det[j, :2] + 0.5 * det[j, 2:4]
+            off = det[j, 5:7] - c
+            if not np.all(np.isfinite(off)):
+                continue
+            prev = self._offsets.get(tid)
+            self._offsets[tid] = off if prev is None else prev + self._smooth * (off - prev)
+        sel = np.flatnonzero(st.confirmed)
+        out = np.empty((sel.size, len(TRACK_COLUMNS)))
+        for r, i in enumerate(sel):
+            tid = int(st.ids[i])
+            off = self._offsets.get(tid)
+            if off is None:
+                off = np.array([0.0, 0.5 * boxes[i, 3]])
+            out[r, 0] = tid
+            out[r, 1:5] = boxes[i]
+            out[r, 5:7] = centres[i] + off
+            out[r, 7] = st.misses[i]
+        return out
+
+
+def tracks_to_rows(per_frame: Sequence[FloatArray]) -> FloatArray:
+    """MOT rows ``(frame, id, x, y, w, h)`` from per-frame track arrays (frames 0, 1, …).
+
+    The input of :func:`seawatch.metrics.cle.centre_location_error`.
+    """
+    parts = [
+        np.column_stack([np.full(t.shape[0], k, np.float64), t[:, :5]])
+        for k, t in enumerate(per_frame)
+        if t.shape[0]
+    ]
+    return np.concatenate(parts) if parts else np.empty((0, 6))

@@ -1,0 +1,86 @@
+"""Centre location error (ALGORITHMS.md §1.6) against hand-computed values."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from seawatch.metrics.cle import box_iou, centre_location_error
+
+
+def test_single_target_cle_matches_hand_computed_3_4_5_offsets():
+    gt = np.array([[0.0, 0.0, 30.0, 40.0], [10.0, 0.0, 30.0, 40.0], [20.0, 0.0, 30.0, 40.0]])
+    est = gt.copy()
+    est[:, 0] += 3.0  # centre offsets (3, 4) -> CLE 5 px
+    est[:, 1] += 4.0
+    est[2, :2] += [30.0, 40.0]  # frame 2: offsets (33, 44) -> CLE 55 px
+    r = centre_location_error(est, gt)
+    assert r.per_frame == pytest.approx([5.0, 5.0, 55.0])
+    assert r.mean_px == pytest.approx(65.0 / 3)
+    assert r.mean_percent == pytest.approx((5 + 5 + 55) / 50.0 * 100 / 3)  # diagonal 50 px
+    assert r.precision == pytest.approx(200.0 / 3)  # 2 of 3 frames <= 20 px
+    assert r.coverage == 1.0
+
+
+def test_missing_estimate_fails_precision_but_not_mean():
+    gt = np.array([[0.0, 0.0, 6.0, 8.0]] * 4)
+    est = gt.copy()
+    est[1] = np.nan
+    gt[3] = np.nan  # target absent in frame 3
+    r = centre_location_error(est, gt)
+    assert math.isnan(r.per_frame[1]) and math.isnan(r.per_frame[3])
+    assert r.mean_px == 0.0
+    assert r.precision == pytest.approx(200.0 / 3)  # frames 0, 2 of the 3 truth frames
+    assert r.coverage == pytest.approx(2 / 3)
+
+
+def test_threshold_is_configurable():
+    gt = np.array([[0.0, 0.0, 10.0, 10.0]])
+    est = np.array([[12.0, 0.0, 10.0, 10.0]])
+    assert centre_location_error(est, gt).precision == 100.0
+    assert centre_location_error(est, gt, threshold=10.0).precision == 0.0
+
+
+def test_mot_rows_match_tracks_to_objects_by_overlap_not_id():
+    # two objects; track 7 follows object 2 and track 9 follows object 1 (ids unrelated)
+    gt, est = [], []
+    for k in range(5):
+        gt += [[k, 1, 0.0, 0.0, 10, 10], [k, 2, 100.0, 0.0, 10, 10]]
+        est += [[k, 9, 1.0, 0.0, 10, 10], [k, 7, 100.0, 2.0, 10, 10]]
+    r = centre_location_error(np.array(est, float), np.array(gt, float))
+    assert r.matches == {7: 2, 9: 1}
+    assert r.per_frame.reshape(5, 2) == pytest.approx(np.tile([1.0, 2.0], (5, 1)))
+    assert r.mean_px == pytest.approx(1.5)
+
+
+def test_brief_jump_to_neighbour_stays_with_majority_object():
+    gt, est = [], []
+    for k in range(6):
+        gt += [[k, 1, 0.0, 0.0, 10, 10], [k, 2, 30.0, 0.0, 10, 10]]
+        x = 30.0 if k == 5 else 0.0  # track 1 jumps onto object 2 in the last frame
+        est.append([k, 1, x, 0.0, 10, 10])
+    r = centre_location_error(np.array(est, float), np.array(gt, float))
+    assert r.matches == {1: 1}
+    per = r.per_frame.reshape(6, 2)
+    assert per[:5, 0] == pytest.approx(0.0)
+    assert per[5, 0] == pytest.approx(30.0)  # scored against its own ship
+    assert np.all(np.isnan(per[:, 1]))
+
+
+def test_box_iou_closed_forms():
+    assert box_iou([0, 0, 10, 10], [5, 0, 10, 10]) == pytest.approx(50 / 150)
+    assert box_iou([0, 0, 10, 10], [20, 0, 10, 10]) == 0.0
+    assert box_iou([0, 0, 0, 0], [0, 0, 0, 0]) == 0.0
+
+
+@pytest.mark.parametrize("bad", [np.zeros((3, 3)), np.zeros(4), np.zeros((2, 5))])
+def test_bad_shapes_raise_naming_est_boxes(bad):
+    with pytest.raises(ValueError, match="est_boxes"):
+        centre_location_error(bad, np.zeros((3, 4)))
+
+
+def test_frame_count_mismatch_raises():
+    with pytest.raises(ValueError, match="est_boxes"):
+        centre_location_error(np.zeros((2, 4)), np.zeros((3, 4)))

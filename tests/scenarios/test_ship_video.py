@@ -1,0 +1,35 @@
+"""ship-video scenario: record shapes and the order sweep (tiny run)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from seawatch.scenarios.ship_video import run
+
+
+def test_record_shapes_and_sweep(tmp_path):
+    res = run(
+        cases=["small"], width=640, height=360, small_scale=3, duration=1.6,
+        orders=(0.8, 1.0), out_dir=tmp_path,
+    )  # fmt: skip
+    assert res.scenario == "ship-video" and res.runs == 1
+    for est in ("afkf", "fkf", "kf"):
+        for metric, unit in (("cle_px", "px"), ("cle_percent", "%"), ("cle_precision", "%")):
+            rec = res.find(est, metric, case="small")
+            assert rec["unit"] == unit and rec["params"] == {"case": "small"}
+            assert math.isfinite(rec["mean"]) and rec["stderr"] is None
+    for a in (0.8, 1.0):
+        assert res.find("afkf", "cle_percent", order=a)["params"] == {"order": a}
+    assert len(res.results) == 9 + 2
+    assert set(res.extra["ordering"]) == {"small"}
+    assert res.extra["best_order"] in (0.8, 1.0)
+    assert (tmp_path / "cle.csv").exists() and (tmp_path / "small" / "video.mp4").exists()
+
+
+def test_bad_arguments_raise():
+    with pytest.raises(ValueError, match="cases"):
+        run(cases=["tiny"])
+    with pytest.raises(ValueError, match="runs"):
+        run(runs=0)

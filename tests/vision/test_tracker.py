@@ -1,0 +1,94 @@
+"""VisualTracker: ids, occlusion survival by prediction, CLE on rendered footage."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from seawatch.metrics.cle import centre_location_error
+from seawatch.scenarios.ship_video import detect_video, read_truth
+from seawatch.synth import render_case
+from seawatch.vision.tracker import TRACK_COLUMNS, VisualTracker, tracks_to_rows
+
+
+def _crossing(T=80, gap=range(30, 38)):
+    """Two boxes crossing at frame ~37; object 2 undetected during ``gap``."""
+    rng = np.random.default_rng(1234)
+    gt, dets = [], []
+    for k in range(T):
+        a = np.array([100.0 + 2 * k, 200.0, 40.0, 10.0])
+        b = np.array([250.0 - 2 * k, 206.0, 30.0, 12.0])
+        gt += [[k, 1, *a], [k, 2, *b]]
+        d = [a + np.r_[rng.normal(0, 1.0, 2), 0, 0]]
+        if k not in gap:
+            d.append(b + np.r_[rng.normal(0, 1.0, 2), 0, 0])
+        dets.append(np.array(d))
+    return np.array(gt), dets
+
+
+@pytest.mark.parametrize("name", ["afkf", "fkf", "kf"])
+def test_one_id_per_ship_through_missed_detections(name):
+    gt, dets = _crossing()
+    vt = VisualTracker(detector=lambda *a, **k: None, filter=name, horizon=False)
+    out = vt.track_detections(dets)
+    assert all(t.shape[1] == len(TRACK_COLUMNS) for t in out)
+    rows = tracks_to_rows(out)
+    assert np.unique(rows[:, 1]).size == 2  # no id switch, no new id after the gap
+    r = centre_location_error(rows, gt)
+    assert sorted(r.matches.values()) == [1, 2]
+    # confirmed after 3 detections (M-of-N 3/5): frames 2.. of each track are covered,
+    # including the 8 frames without detections of object 2 (coasting)
+    assert r.coverage == pytest.approx(78 / 80)
+    coasting = [t[t[:, 7] > 0] for t in out[30:38]]
+    assert all(c.shape[0] == 1 for c in coasting)
+    assert r.mean_px < 3.0
+
+
+def test_waterline_defaults_to_box_bottom_centre():
+    vt = VisualTracker(detector=lambda *a, **k: None, horizon=False, filter="kf")
+    out = [vt.update(np.array([[10.0, 20.0, 8.0, 4.0]])) for _ in range(4)]
+    t = out[-1][0]
+    assert t[5] == pytest.approx(t[1] + 0.5 * t[3], abs=1e-6)
+    assert t[6] == pytest.approx(t[2] + t[4], abs=1e-6)
+
+
+def test_bad_arguments_raise_naming_them():
+    with pytest.raises(ValueError, match="filter"):
+        VisualTracker(filter="ukf")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="memory"):
+        VisualTracker(memory=0)
+    with pytest.raises(ValueError, match="detections"):
+        VisualTracker(horizon=False).update(np.zeros((2, 3)))
+
+
+@pytest.fixture(scope="module")
+def rendered(tmp_path_factory):
+    out = {}
+    for name in ("large", "meeting"):
+        res = render_case(name, tmp_path_factory.mktemp(name), duration=3.0, width=960, height=540)
+        out[name] = (detect_video(res.video), read_truth(res.truth))
+    return out
+
+
+def test_rendered_large_ship_cle_below_2_percent_of_diagonal(rendered):
+    dets, truth = rendered["large"]
+    vt = VisualTracker(detector=lambda *a, **k: None, horizon=False)
+    rows = tracks_to_rows(vt.track_detections(dets))
+    r = centre_location_error(rows, truth)
+    assert np.unique(rows[:, 1]).size == 1
+    assert r.coverage > 0.9
+    assert r.mean_percent < 2.0  # issue 6 target (measured ~0.4 %)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="the classical detector returns one merged box while the two ships overlap "
+    "(whole 3 s meeting clip at 960x540): one track, ~49 % coverage",
+)
+def test_rendered_meeting_keeps_one_id_per_ship(rendered):
+    dets, truth = rendered["meeting"]
+    vt = VisualTracker(detector=lambda *a, **k: None, horizon=False)
+    rows = tracks_to_rows(vt.track_detections(dets))
+    r = centre_location_error(rows, truth)
+    assert sorted(set(r.matches.values())) == [1, 2]
+    assert np.unique(rows[:, 1]).size == 2
