@@ -6,13 +6,15 @@ progress and logs go to stderr; exit code 0 ok, 1 failed, 2 bad input.
 
 from __future__ import annotations
 
+import csv
 import json
 import math
 import sys
 import warnings
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
-from typing import Any
+from pathlib import Path
+from typing import Any, TextIO
 
 import numpy as np
 import typer
@@ -84,6 +86,32 @@ def warnings_to_stderr() -> Iterator[None]:
             yield
         finally:
             warnings.showwarning = previous
+
+
+def open_csv(output: Path | None, columns: Sequence[str]) -> tuple[TextIO | None, Any]:
+    """Open ``-o/--output`` for row-by-row CSV writing with its header already flushed.
+
+    Returns ``(file, csv_writer)``, both None without an output; an unwritable path is
+    bad input (exit 2) before any work starts.
+    """
+    if output is None:
+        return None, None
+    try:
+        sink = output.open("w", newline="", encoding="utf-8")
+    except OSError as exc:
+        raise BadInput(f"--output {output}: cannot write ({exc.strerror})") from None
+    writer = csv.writer(sink)
+    writer.writerow(columns)
+    sink.flush()
+    return sink, writer
+
+
+def expected_frames(frame_count: int | None, step: int, max_frames: int | None) -> int | None:
+    """Frames a reader will deliver (for a progress bar), None when unknown (live)."""
+    if frame_count is None:
+        return None
+    total = max(1, math.ceil(frame_count / step))
+    return total if max_frames is None else min(total, max_frames)
 
 
 def progress_bar() -> Progress:

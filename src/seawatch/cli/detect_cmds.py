@@ -25,11 +25,9 @@ go to stderr.
 
 from __future__ import annotations
 
-import csv
-import math
 import sys
 from pathlib import Path
-from typing import Annotated, Any, TextIO
+from typing import Annotated, Any
 
 import typer
 
@@ -38,6 +36,8 @@ from seawatch.cli._common import (
     emit_json,
     err,
     exit_codes,
+    expected_frames,
+    open_csv,
     progress_bar,
     warnings_to_stderr,
 )
@@ -168,21 +168,8 @@ def detect(
         )
         horizon_of = _horizon_source(reader, use_horizon)
         records: list[dict[str, Any]] = []
-        sink: TextIO | None = None
-        writer = None
-        if output is not None:
-            try:
-                sink = output.open("w", newline="", encoding="utf-8")
-            except OSError as exc:
-                raise BadInput(f"--output {output}: cannot write ({exc.strerror})") from None
-            writer = csv.writer(sink)
-            writer.writerow(CSV_COLUMNS)
-            sink.flush()
-        total = reader.frame_count
-        if total is not None:
-            total = max(1, math.ceil(total / step))
-            if max_frames is not None:
-                total = min(total, max_frames)
+        sink, writer = open_csv(output, CSV_COLUMNS)
+        total = expected_frames(reader.frame_count, step, max_frames)
         failure: Exception | None = None
         n_boxes = 0
         try:

@@ -23,11 +23,10 @@ change, a dropped stream, non-image files in a folder) go to stderr.
 
 from __future__ import annotations
 
-import csv
 import math
 import sys
 from pathlib import Path
-from typing import Annotated, Any, TextIO
+from typing import Annotated, Any
 
 import typer
 
@@ -36,6 +35,8 @@ from seawatch.cli._common import (
     emit_json,
     err,
     exit_codes,
+    expected_frames,
+    open_csv,
     progress_bar,
     warnings_to_stderr,
 )
@@ -130,21 +131,8 @@ def horizon(
         use_tracker = (reader.kind not in ("folder", "image")) if smooth is None else smooth
         tracker = HorizonTracker(max_tilt_deg=max_tilt, fps=reader.fps or 25.0)
         records: list[dict[str, Any]] = []
-        sink: TextIO | None = None
-        writer = None
-        if output is not None:
-            try:
-                sink = output.open("w", newline="", encoding="utf-8")
-            except OSError as exc:
-                raise BadInput(f"--output {output}: cannot write ({exc.strerror})") from None
-            writer = csv.writer(sink)
-            writer.writerow(CSV_COLUMNS)
-            sink.flush()
-        total = reader.frame_count
-        if total is not None:
-            total = max(1, math.ceil(total / step))
-            if max_frames is not None:
-                total = min(total, max_frames)
+        sink, writer = open_csv(output, CSV_COLUMNS)
+        total = expected_frames(reader.frame_count, step, max_frames)
         failure: Exception | None = None
         try:
             with progress_bar() as bar:
