@@ -14,7 +14,14 @@ import typer
 from rich.table import Table
 
 from seawatch import __version__
-from seawatch.cli import detect_cmds, geometry_cmds, horizon_cmds, synth_cmds, tbd_cmds
+from seawatch.cli import (
+    detect_cmds,
+    geometry_cmds,
+    horizon_cmds,
+    sweep_cmds,
+    synth_cmds,
+    tbd_cmds,
+)
 from seawatch.cli._common import EXIT_FAILED, BadInput, emit_json, err, exit_codes, progress_bar
 
 app = typer.Typer(
@@ -129,6 +136,13 @@ def experiment(
     fov: Annotated[
         float | None, typer.Option(help="solent-ais: horizontal field of view (deg).")
     ] = None,
+    workers: Annotated[
+        int | None,
+        typer.Option(help="Dask worker processes (default: the machine's cores).", min=1),
+    ] = None,
+    scheduler: Annotated[
+        str | None, typer.Option(help="Existing Dask scheduler, e.g. tcp://HOST:8786.")
+    ] = None,
     json_out: Annotated[bool, typer.Option("--json", help="Print the experiment JSON.")] = False,
 ) -> None:
     """Run one of the papers' experiments by name and compare with the paper.
@@ -140,11 +154,14 @@ def experiment(
     Example: [cyan]seawatch experiment air-range --runs 100 --out out/air-range[/]
 
     Example: [cyan]seawatch experiment solent-ais --camera-height 30 --fov 50 --json[/]
+
+    Example: [cyan]seawatch experiment uav-sea --runs 4000 --workers 2[/] (Dask; the same
+    records for any number of workers)
     """
     from seawatch.scenarios import registry
 
     with exit_codes():
-        run = registry.runner(name)
+        registry.runner(name)  # unknown names: exit 2 before any work
         kwargs: dict[str, object] = {"seed": seed, "out_dir": out}
         if runs is not None:
             kwargs["runs"] = runs
@@ -167,7 +184,10 @@ def experiment(
             kwargs[key] = value
         with progress_bar() as bar:
             task = bar.add_task(name, total=None)
-            result = run(
+            result = sweep_cmds.experiment_parallel(
+                name,
+                workers=workers,
+                scheduler=scheduler,
                 progress=lambda done, total: bar.update(task, completed=done, total=total),
                 **kwargs,
             )
@@ -275,6 +295,7 @@ app.command()(geometry_cmds.calibrate)
 app.command()(tbd_cmds.tbd)
 app.command()(horizon_cmds.horizon)
 app.command()(detect_cmds.detect)
+app.command()(sweep_cmds.sweep)
 app.add_typer(synth_cmds.app, name="synth")
 
 

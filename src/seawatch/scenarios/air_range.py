@@ -43,17 +43,22 @@ filter beats the raw range in the level flight; the paper's "large σ_v better l
 holds; its "small σ_v better early" does not (the first seconds are limited by the
 diffuse start and all σ_v agree there; later the range acceleration of the 1000 m miss
 distance, 0.35 → 2.6 m/s², already favours σ_v = 10 over 1); ncv-1 cannot follow the
-pull-up and is worse than raw over the whole run (40.7 m against 32.3 m); ANCV
-(10.9 m) and ANCA (10.8 m) beat every fixed-noise filter over the whole run (best
-fixed: nca-0.1, 13.9 m) thanks to the pull-up, while in the level flight they are
-slightly worse than the fixed filters (12.9 m against 12.1–12.7 m).
+pull-up and is worse than raw over the whole run (40.6 m against 32.1 m); ANCV
+(10.5 m) and ANCA (10.4 m) beat every fixed-noise filter over the whole run (best
+fixed: nca-0.1, 13.4 m) thanks to the pull-up, while in the level flight they are
+slightly worse than the fixed filters (12.4/12.3 m against 11.4–12.0 m).
+
+Randomness: run i draws from ``numpy.random.default_rng(SeedSequence(seed,
+spawn_key=(i,)))``, so its numbers do not depend on how the runs are split into chunks
+or Dask workers (:func:`chunk` / :func:`merge`, the protocol of
+:mod:`seawatch.scenarios.parallel`).
 """
 
 from __future__ import annotations
 
 import csv
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -92,6 +97,11 @@ INITIAL_ACCEL_STD_MPS2 = 10.0
 WINDOW = 50
 
 ProgressCallback = Callable[[int, int], None]
+
+CHUNK_MIN = 500
+"""Smallest chunk of the parallel runner's default plan (a chunk costs ~0.5 s + 6 ms/run)."""
+PARALLEL_MIN_COST = 2000
+"""Below this many runs the default (no ``--workers``) runs in one process."""
 
 
 @dataclass(frozen=True)
@@ -259,10 +269,22 @@ class AirRangeMeasurements:
     seed: int
 
 
+def _run_noise(indices: Sequence[int], seed: int, frames: int) -> FloatArray:
+    """Standard normals (B, frames); run i from ``SeedSequence(seed, spawn_key=(i,))``."""
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ValueError(f"seed: expected a non-negative integer, got {seed!r}")
+    out = np.empty((len(indices), frames))
+    for b, i in enumerate(indices):
+        ss = np.random.SeedSequence(int(seed), spawn_key=(int(i),))
+        out[b] = np.random.default_rng(ss).standard_normal(frames)
+    return out
+
+
 def simulate(
     runs: int = 100,
     seed: int = 0,
     *,
+    start: int = 0,
     truth: AirRangeTrajectory | None = None,
     sigma_l: float = SIGMA_L_PX,
     focal: float = FOCAL_PX,
@@ -270,15 +292,28 @@ def simulate(
 ) -> AirRangeMeasurements:
     """Monte-Carlo image-size measurements ``l = f L / d + N(0, σ_l²)`` and ``d = f L / l``.
 
-    ALGORITHMS.md §5.1, seed 002 eq. 14. ``runs`` independent noise draws of the whole
-    trajectory from ``numpy.random.default_rng(seed)``.
+    ALGORITHMS.md §5.1, seed 002 eq. 14. Runs ``start … start + runs − 1``; run i draws
+    its noise from ``numpy.random.default_rng(SeedSequence(seed, spawn_key=(i,)))``, so a
+    run's numbers do not depend on how the runs are split into blocks or workers.
     """
     runs = _check_runs(runs)
+    if isinstance(start, bool) or not isinstance(start, int | np.integer) or start < 0:
+        raise ValueError(f"start: expected a non-negative integer, got {start!r}")
+    return _simulate_runs(range(int(start), int(start) + runs), seed, truth, sigma_l, focal, size)
+
+
+def _simulate_runs(
+    indices: Sequence[int],
+    seed: int,
+    truth: AirRangeTrajectory | None = None,
+    sigma_l: float = SIGMA_L_PX,
+    focal: float = FOCAL_PX,
+    size: float = SIZE_M,
+) -> AirRangeMeasurements:
     truth = trajectory() if truth is None else truth
     fL = positive("focal", focal) * positive("size", size)
     sl = positive("sigma_l", sigma_l, allow_zero=True)
-    rng = np.random.default_rng(seed)
-    l = fL / truth.range + sl * rng.standard_normal((runs, truth.range.shape[0]))
+    l = fL / truth.range + sl * _run_noise(indices, seed, truth.range.shape[0])
     if np.any(l <= 0.0):
         raise ValueError("sigma_l: noise this large makes image sizes non-positive")
     return AirRangeMeasurements(image_size=l, range=fL / l, truth=truth, seed=int(seed))
@@ -415,24 +450,50 @@ def _metric_records(
     return out
 
 
-def run(runs: int = 100, seed: int = 0, progress: ProgressCallback | None = None) -> AirRangeResult:
-    """Run the ``air-range`` comparison: raw, NCV ×3, NCA ×3, ANCV, ANCA.
+@dataclass(frozen=True)
+class AirRangeChunk:
+    """Per-run output of :func:`chunk` (what a Dask task returns).
+
+    Attributes:
+        runs: global run indices, (B,).
+        errors: per estimator, range error estimate − truth [m], (B, N).
+        sigma_v: per adaptive filter, σ_v at each frame [m/s²], (B, N).
+        params: per estimator, the record ``params``.
+    """
+
+    runs: NDArray[np.int64]
+    errors: dict[str, FloatArray]
+    sigma_v: dict[str, FloatArray]
+    params: dict[str, dict[str, Any]]
+
+
+def chunk(
+    indices: Sequence[int],
+    runs: int | None = None,
+    seed: int = 0,
+    *,
+    progress: ProgressCallback | None = None,
+) -> AirRangeChunk:
+    """Runs ``indices`` of the comparison (the parallel protocol of
+    :mod:`seawatch.scenarios.parallel`): per-run errors of raw, NCV ×3, NCA ×3, ANCV, ANCA.
+
+    Run i draws from its own stream (:func:`simulate`) and the filters treat the runs of
+    a batch independently, so run i's errors are the same whatever chunk it is in.
 
     Args:
-        runs: Monte-Carlo runs (all filters see the same noise draws).
+        indices: global run indices.
+        runs: total number of runs (unused: a run does not depend on it).
         seed: seed of the measurement noise.
-        progress: optional ``callable(done, total)`` called after each estimator.
-
-    Returns:
-        AirRangeResult with the records of every estimator × metric, the per-frame
-        errors and the σ_v histories.
+        progress: ``progress(done, total)`` after each estimator (total 9).
     """
-    meas = simulate(runs, seed)
+    idx = np.asarray(list(indices), dtype=np.int64)
+    if idx.size == 0 or np.any(idx < 0):
+        raise ValueError(f"indices: expected non-negative run indices, got {indices!r}")
+    meas = _simulate_runs(idx.tolist(), seed)
     truth = meas.truth
-    far = truth.range > FAR_RANGE_M
     total = len(ESTIMATORS) + 1
     errors: dict[str, FloatArray] = {"raw": meas.range - truth.range}
-    records = _metric_records("raw", errors["raw"], far, {})
+    params: dict[str, dict[str, Any]] = {"raw": {}}
     sigma_v: dict[str, FloatArray] = {}
     if progress is not None:
         progress(1, total)
@@ -445,12 +506,52 @@ def run(runs: int = 100, seed: int = 0, progress: ProgressCallback | None = None
         sig = np.full(z.shape, np.nan)
         sig[:, 1:] = res.sigma_v
         sigma_v[spec.name] = sig
-        records += _metric_records(spec.name, errors[spec.name], far, _params(spec, flt))
+        params[spec.name] = _params(spec, flt)
         if progress is not None:
             progress(i, total)
+    return AirRangeChunk(runs=idx, errors=errors, sigma_v=sigma_v, params=params)
+
+
+def _combine(payloads: Sequence[AirRangeChunk], seed: int) -> AirRangeResult:
+    """Concatenate chunks (in run order) and compute the records over all runs."""
+    if not payloads:
+        raise ValueError("payloads: expected at least one chunk")
+    order = sorted(payloads, key=lambda p: int(p.runs[0]))
+    truth = trajectory()
+    far = truth.range > FAR_RANGE_M
+    names = list(order[0].errors)
+    errors = {n: np.concatenate([p.errors[n] for p in order]) for n in names}
+    sigma_v = {n: np.concatenate([p.sigma_v[n] for p in order]) for n in order[0].sigma_v}
+    records: list[dict[str, Any]] = []
+    for n in names:
+        records += _metric_records(n, errors[n], far, order[0].params[n])
     return AirRangeResult(
-        runs=runs, seed=int(seed), truth=truth, records=records, errors=errors, sigma_v=sigma_v
+        runs=int(errors["raw"].shape[0]),
+        seed=int(seed),
+        truth=truth,
+        records=records,
+        errors=errors,
+        sigma_v=sigma_v,
     )
+
+
+def run(runs: int = 100, seed: int = 0, progress: ProgressCallback | None = None) -> AirRangeResult:
+    """Run the ``air-range`` comparison: raw, NCV ×3, NCA ×3, ANCV, ANCA.
+
+    ``chunk(range(runs))`` then the records over the runs (the same code as the
+    parallel runner's :func:`chunk` + :func:`merge`).
+
+    Args:
+        runs: Monte-Carlo runs (all filters see the same noise draws).
+        seed: seed of the measurement noise (run i: ``SeedSequence(seed, spawn_key=(i,))``).
+        progress: optional ``callable(done, total)`` called after each estimator.
+
+    Returns:
+        AirRangeResult with the records of every estimator × metric, the per-frame
+        errors and the σ_v histories.
+    """
+    n = _check_runs(runs)
+    return _combine([chunk(range(n), n, seed, progress=progress)], seed)
 
 
 @dataclass(frozen=True)
@@ -500,11 +601,14 @@ def run_demo(
     decreasing left to right, like the approach), the raw measurement's σ_d for
     reference, and the σ_v the adaptive filters chose.
     """
+    return _write_demo(run(runs, seed, progress), out_dir)
+
+
+def _write_demo(result: AirRangeResult, out_dir: Path | str) -> DemoResult:
     from seawatch.report.air_range_plot import plot_range_errors
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    result = run(runs, seed, progress)
     rows = result.table_rows()
     table_path = write_table(rows, out / "errors.csv")
     truth = result.truth
@@ -521,7 +625,7 @@ def run_demo(
         out / "range_error.png",
         sigma_v={k: np.concatenate([[np.nan], v]) for k, v in adaptive.items()},
         pullup_range=PULLUP_RANGE_M,
-        title=f"air-range: RMS range error over {runs} runs (seed {seed})",
+        title=f"air-range: RMS range error over {result.runs} runs (seed {result.seed})",
     )
     return DemoResult(
         rows=rows, records=result.records, table_path=table_path, plot_path=plot_path, result=result
@@ -534,17 +638,33 @@ def _check_runs(runs: int) -> int:
     return int(runs)
 
 
+def merge(
+    payloads: Sequence[AirRangeChunk],
+    runs: int | None = None,
+    seed: int = 0,
+    out_dir: Path | str | None = None,
+) -> ExperimentResult:
+    """The experiment JSON from the chunks of :func:`chunk` (in run order; the parallel
+    protocol of :mod:`seawatch.scenarios.parallel`), plus ``errors.csv`` and
+    ``range_error.png`` in ``out_dir`` when one is given."""
+    result = _combine(payloads, seed)
+    if runs is not None and result.runs != runs:
+        raise ValueError(f"payloads: expected {runs} runs in all, got {result.runs}")
+    if out_dir is None:
+        return ExperimentResult(SCENARIO, result.runs, int(seed), result.records)
+    demo = _write_demo(result, out_dir)
+    return ExperimentResult(
+        SCENARIO, result.runs, int(seed), demo.records, outputs=[demo.table_path, demo.plot_path]
+    )
+
+
 def experiment(
     runs: int = 100,
     seed: int = 0,
     out_dir: Path | None = None,
     progress: ProgressCallback | None = None,
 ) -> ExperimentResult:
-    """``seawatch experiment air-range``: :func:`run`, plus ``errors.csv`` and
-    ``range_error.png`` in ``out_dir`` when one is given."""
-    if out_dir is None:
-        return ExperimentResult("air-range", runs, seed, run(runs, seed, progress).records)
-    demo = run_demo(out_dir, runs=runs, seed=seed, progress=progress)
-    return ExperimentResult(
-        "air-range", runs, seed, demo.records, outputs=[demo.table_path, demo.plot_path]
-    )
+    """``seawatch experiment air-range``: ``merge([chunk(range(runs))])`` — :func:`run`,
+    plus ``errors.csv`` and ``range_error.png`` in ``out_dir`` when one is given."""
+    n = _check_runs(runs)
+    return merge([chunk(range(n), n, seed, progress=progress)], n, seed, out_dir)

@@ -46,26 +46,35 @@ Cases (``run(table=…)``):
 A newly confirmed track is false when the mark it ends on is clutter; a target is
 "reported" in a frame when a detection row's mark is that target's mark.
 
+Randomness and parallel runs: each work unit — a Table 2 row, a Table 1 sequence, a
+case sequence — draws from its own stream, ``SeedSequence(seed, spawn_key=(key, k))``
+(:func:`chunk`), so the results do not depend on how the units are split over Dask
+workers (:func:`chunk` / :func:`merge`, the protocol of
+:mod:`seawatch.scenarios.parallel`; a Table 2 row is one unit because its frames pass
+through stateful detectors).
+
 Outcome (defaults, seed 0; ``tests/scenarios/test_clutter_tbd.py`` checks the main
 points on fewer frames):
 
-* Table 2: 28 of the 29 entries with a published value > 0 are within a factor of 2
-  (N = 3: ratios 0.96–1.08; N = 4: 0.78–1.03). The exception is n = 240, N = 5:
-  0.0088 ± 0.0014 against 0.018. The §8.3 approximation gives 0.0075 there. The
-  published value is 18 events in 1000 frames, 2.1 standard errors from ours when its
-  own Poisson error is counted, and its neighbour (0.016 at n = 260) is smaller. The
-  literal rule (``gate-literal``, distinct marks) fits as well: 31.9 against 31.55 at
-  n = 300, N = 3.
-* Table 1: 0.29 (41 px) … 1.01 (161 px) false alarms in 50 frames, against the
-  paper's 1 … 3. The order is the same ("a handful"), but ours grows ×3.5 with the gate
+* Table 2: 26 of the 29 entries with a published value > 0 are within a factor of 2
+  (N = 3: ratios 0.99–1.07; N = 4: 0.79–1.42). The exceptions are all N = 5, where
+  ours is below the paper at every clutter level (ratios 0.27–0.77) and close to the
+  §8.3 approximation: n = 180, 0.0008 ± 0.0004 against 0.003 (analytic 0.0018);
+  n = 220, 0.0036 ± 0.0008 against 0.008 (0.0048); n = 240, 0.0084 ± 0.0014 against
+  0.018 (0.0075). The published N = 5 values are counts of 3–27 events in 1000
+  frames: counting their own Poisson error, the three are 1.2, 1.5 and 2.2 standard
+  errors from ours. The literal rule (``gate-literal``, distinct marks) fits as well:
+  32.4 against 31.55 at n = 300, N = 3.
+* Table 1: 0.37 (41 px) … 1.15 (161 px) false alarms in 50 frames, against the
+  paper's 1 … 3. The order is the same ("a handful"), but ours grows ×3 with the gate
   where the paper's stays flat. The analytic estimate (0.08 → 0.79) predicts that growth
   from the big gate's area. The target is never missed.
 * Fig. 4: no target missed in 100 sequences; reported in 99.9 % of the eligible
   target-frames; 0.52 false alarms per frame.
-* Crossing: no target missed; 98.5 % reported; 1.8 id switches per sequence. Most come
+* Crossing: no target missed; 98.5 % reported; 1.6 id switches per sequence. Most come
   from one-frame swaps at the steep crossing, where the two marks are 1 px apart, and
   from the 16° crossing, where the targets' marks stay within 2–4 px for several frames
-  and a track may follow the other target. Splitting: no target missed, 99.8 %.
+  and a track may follow the other target. Splitting: no target missed, 99.9 %.
 """
 
 from __future__ import annotations
@@ -74,7 +83,7 @@ import csv
 import itertools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
 from typing import Any
@@ -322,44 +331,48 @@ def target_frames(
 # --------------------------------------------------------------------------------------
 
 
-def _table2(
-    frames_per_point: int,
-    levels: Sequence[int],
-    rng: np.random.Generator,
-    progress: ProgressCallback | None,
-    done: list[int],
-    total: int,
+def _table2_point(
+    n: int, frames_per_point: int, rng: np.random.Generator
+) -> dict[str, dict[tuple[int, bool], FloatArray]]:
+    """One Table 2 row: one clutter sequence of ``n`` marks per frame through the six
+    detectors (N = 3, 4, 5 × seed exclusion on/off); per-frame new tracks and marks."""
+    dets = {
+        (N, se): GateTBD(
+            TABLE2_FRAME,
+            LARGE_GATE,
+            SMALL_GATE,
+            n_frames=N,
+            linearity_threshold=EPS_PX,
+            seed_exclusion=se,
+        )
+        for N in TABLE2_N
+        for se in (True, False)
+    }
+    frames = {key: frames_per_point * (N5_FACTOR if key[0] == 5 else 1) for key in dets}
+    tracks = {key: np.zeros(f) for key, f in frames.items()}
+    marks = {key: np.zeros(f) for key, f in frames.items()}
+    for k in range(BURN_IN + max(frames.values())):
+        z = clutter(rng, n, TABLE2_FRAME)
+        for key, det in dets.items():
+            if k >= BURN_IN + frames[key]:
+                continue
+            det.push(z)
+            if k >= BURN_IN:
+                st = det.last_stats
+                assert st is not None
+                tracks[key][k - BURN_IN] = st.new_tracks
+                marks[key][k - BURN_IN] = st.new_marks
+    return {"tracks": tracks, "marks": marks}
+
+
+def _table2_records(
+    levels: Sequence[int], points: dict[int, dict[str, dict[tuple[int, bool], FloatArray]]]
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     records: list[dict[str, Any]] = []
     rows: list[dict[str, Any]] = []
     for n in levels:
         paper = TABLE2_PAPER[n]
-        dets = {
-            (N, se): GateTBD(
-                TABLE2_FRAME,
-                LARGE_GATE,
-                SMALL_GATE,
-                n_frames=N,
-                linearity_threshold=EPS_PX,
-                seed_exclusion=se,
-            )
-            for N in TABLE2_N
-            for se in (True, False)
-        }
-        frames = {key: frames_per_point * (N5_FACTOR if key[0] == 5 else 1) for key in dets}
-        tracks = {key: np.zeros(f) for key, f in frames.items()}
-        marks = {key: np.zeros(f) for key, f in frames.items()}
-        for k in range(BURN_IN + max(frames.values())):
-            z = clutter(rng, n, TABLE2_FRAME)
-            for key, det in dets.items():
-                if k >= BURN_IN + frames[key]:
-                    continue
-                det.push(z)
-                if k >= BURN_IN:
-                    st = det.last_stats
-                    assert st is not None
-                    tracks[key][k - BURN_IN] = st.new_tracks
-                    marks[key][k - BURN_IN] = st.new_marks
+        tracks, marks = points[n]["tracks"], points[n]["marks"]
         for N, p in zip(TABLE2_N, paper, strict=True):
             params = {"clutter": n, "N": N, "table": 2}
             gate, lit = (N, True), (N, False)
@@ -399,47 +412,43 @@ def _table2(
                     "frames": int(tracks[gate].size),
                 }
             )
-        done[0] += 1
-        if progress is not None:
-            progress(done[0], total)
     return records, rows
 
 
-def _table1(
-    sequences: int,
-    rng: np.random.Generator,
-    progress: ProgressCallback | None,
-    done: list[int],
-    total: int,
+def _table1_sequence(rng: np.random.Generator) -> tuple[list[FloatArray], IntArray]:
+    """One Table 1 sequence: a target at 5 px/frame in a random direction plus clutter."""
+    rows_px, cols_px = TABLE1_FRAME
+    ang = rng.uniform(0, 2 * math.pi)
+    vr, vc = TABLE1_SPEED * math.sin(ang), TABLE1_SPEED * math.cos(ang)
+    dr, dc = vr * (TABLE1_FRAMES - 1), vc * (TABLE1_FRAMES - 1)
+    r0 = rng.uniform(10 + max(0.0, -dr), rows_px - 11 - max(0.0, dr))
+    c0 = rng.uniform(10 + max(0.0, -dc), cols_px - 11 - max(0.0, dc))
+    return target_frames([Target(r0, c0, vr, vc)], TABLE1_FRAMES, TABLE1_CLUTTER, TABLE1_FRAME, rng)
+
+
+def _table1_gate(gate: int, frames: list[FloatArray], tmark: IntArray) -> tuple[float, float]:
+    """(false alarms over the sequence, 1 if the target was never reported) for one gate."""
+    det = GateTBD(TABLE1_FRAME, gate, SMALL_GATE, TABLE1_N, linearity_threshold=EPS_PX)
+    seen = False
+    false_total = 0.0
+    for k, z in enumerate(frames):
+        det.push(z)
+        st = det.last_stats
+        assert st is not None
+        false_total += np.count_nonzero(~np.isin(st.new_track_marks, tmark[k]))
+        seen |= bool(np.isin(tmark[k, 0], st.detection_marks))
+    return false_total, 0.0 if seen else 1.0
+
+
+def _table1_records(
+    results: dict[int, dict[str, FloatArray]],
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """Records and rows of Table 1 from per-gate arrays over the sequences (in order)."""
     records: list[dict[str, Any]] = []
     rows: list[dict[str, Any]] = []
-    rows_px, cols_px = TABLE1_FRAME
-    data = []
-    for _ in range(sequences):  # the same sequences for every gate size
-        ang = rng.uniform(0, 2 * math.pi)
-        vr, vc = TABLE1_SPEED * math.sin(ang), TABLE1_SPEED * math.cos(ang)
-        dr, dc = vr * (TABLE1_FRAMES - 1), vc * (TABLE1_FRAMES - 1)
-        r0 = rng.uniform(10 + max(0.0, -dr), rows_px - 11 - max(0.0, dr))
-        c0 = rng.uniform(10 + max(0.0, -dc), cols_px - 11 - max(0.0, dc))
-        data.append(
-            target_frames(
-                [Target(r0, c0, vr, vc)], TABLE1_FRAMES, TABLE1_CLUTTER, TABLE1_FRAME, rng
-            )
-        )
     for g, paper in TABLE1_PAPER.items():
-        false_total = np.zeros(sequences)
-        missed = np.zeros(sequences)
-        for s, (frames, tmark) in enumerate(data):
-            det = GateTBD(TABLE1_FRAME, g, SMALL_GATE, TABLE1_N, linearity_threshold=EPS_PX)
-            seen = False
-            for k, z in enumerate(frames):
-                det.push(z)
-                st = det.last_stats
-                assert st is not None
-                false_total[s] += np.count_nonzero(~np.isin(st.new_track_marks, tmark[k]))
-                seen |= bool(np.isin(tmark[k, 0], st.detection_marks))
-            missed[s] = 0 if seen else 1
+        false_total, missed = results[g]["false_total"], results[g]["missed"]
+        sequences = false_total.size
         params = {"large_gate": g, "table": 1}
         analytic = float(
             analytic_false_rate(TABLE1_CLUTTER, TABLE1_N, TABLE1_FRAME, g, SMALL_GATE)
@@ -465,20 +474,19 @@ def _table1(
                 "sequences": sequences,
             }
         )
-        done[0] += 1
-        if progress is not None:
-            progress(done[0], total)
     return records, rows
 
 
 def track_case(
     case: str,
     sequences: int,
-    rng: np.random.Generator,
+    rng: np.random.Generator | Sequence[np.random.Generator],
     *,
     seed_exclusion: bool = True,
 ) -> dict[str, FloatArray]:
     """Run a target case (``fig4``, ``crossing``, ``splitting``) ``sequences`` times.
+
+    ``rng`` is one generator for all sequences, or one generator per sequence.
 
     Returns per-sequence arrays: ``targets_missed`` (targets never reported),
     ``tracked_fraction`` (share of target-frames with ≥ N marks of that target so far in
@@ -490,8 +498,11 @@ def track_case(
         k: np.zeros(sequences)
         for k in ("targets_missed", "tracked_fraction", "false_alarms_per_frame", "id_switches")
     }
+    gens = [rng] * sequences if isinstance(rng, np.random.Generator) else list(rng)
+    if len(gens) != sequences:
+        raise ValueError(f"rng: expected {sequences} generators, got {len(gens)}")
     for s in range(sequences):
-        frames, tmark = target_frames(targets, CASE_FRAMES, CASE_CLUTTER, CASE_FRAME, rng)
+        frames, tmark = target_frames(targets, CASE_FRAMES, CASE_CLUTTER, CASE_FRAME, gens[s])
         det = GateTBD(CASE_FRAME, LARGE_GATE, SMALL_GATE, CASE_N, linearity_threshold=EPS_PX,
                       seed_exclusion=seed_exclusion)  # fmt: skip
         n_t = len(targets)
@@ -526,25 +537,21 @@ def track_case(
     return out
 
 
-def _cases(
-    cases: Sequence[str],
-    sequences: int,
-    rng: np.random.Generator,
-    progress: ProgressCallback | None,
-    done: list[int],
-    total: int,
+CASE_UNITS = {
+    "targets_missed": "targets",
+    "tracked_fraction": "1",
+    "false_alarms_per_frame": "1/frame",
+    "id_switches": "switches",
+}
+
+
+def _cases_records(
+    results: dict[str, dict[str, FloatArray]],
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     records: list[dict[str, Any]] = []
     rows: list[dict[str, Any]] = []
-    units = {
-        "targets_missed": "targets",
-        "tracked_fraction": "1",
-        "false_alarms_per_frame": "1/frame",
-        "id_switches": "switches",
-    }
-    for case in cases:
-        res = track_case(case, sequences, rng)
-        for metric, unit in units.items():
+    for case, res in results.items():
+        for metric, unit in CASE_UNITS.items():
             rec = record("gate", metric, unit, res[metric], params={"case": case})
             if case == "fig4" and metric == "targets_missed":
                 rec["paper"] = 0.0
@@ -556,13 +563,10 @@ def _cases(
                     "mean": rec["mean"],
                     "stderr": rec["stderr"],
                     "max": float(np.max(res[metric])),
-                    "sequences": sequences,
+                    "sequences": int(res[metric].size),
                     "targets": len(CASE_TARGETS[case]),
                 }
             )
-        done[0] += 1
-        if progress is not None:
-            progress(done[0], total)
     return records, rows
 
 
@@ -634,43 +638,26 @@ def _check_runs(runs: int | None) -> int:
     return int(runs)
 
 
-def run(
-    table: str = "2",
-    runs: int | None = None,
-    seed: int = 0,
-    out_dir: str | Path | None = None,
-    progress: ProgressCallback | None = None,
-    clutter_levels: Sequence[int] | None = None,
-) -> ExperimentResult:
-    """Run the ``clutter-tbd`` experiment (SCENARIOS.md; seed 004 Tables 1–2, Fig. 4).
+PARALLEL_MIN_COST = 30_000.0
+"""Below this total :func:`unit_costs` (about 8 s of work) the default (no ``--workers``)
+runs in one process."""
+_STREAMS = {"2": 2, "1": 1, "fig4": 4, "crossing": 5, "splitting": 6}
+"""Stream keys: work unit (part, k) draws from ``SeedSequence(seed, spawn_key=(key, k))``."""
 
-    Args:
-        table: ``"2"``, ``"1"``, ``"fig4"``, ``"crossing"``, ``"splitting"`` or ``"all"``.
-        runs: Monte-Carlo size. Table 2: frames measured per (clutter, N) point after a
-            10-frame burn-in (default 1000, the paper's count; 5× as many for N = 5;
-            about a minute for the whole table). Table 1 and the target cases:
-            ``runs // 10`` independent 50-frame sequences (default 100).
-        seed: seed of ``numpy.random.default_rng``.
-        out_dir: if given, ``table2.csv`` + ``table2.png``, ``table1.csv`` and
-            ``cases.csv`` are written there as each table completes.
-        progress: ``progress(done, total)`` after each clutter level, gate size or case.
-        clutter_levels: Table 2 rows to run (default all, 100 … 300 marks per frame).
 
-    Returns:
-        The experiment JSON (INTERFACES.md) as an :class:`ExperimentResult`; ``extra``
-        holds ``"checks"``: Table 2 within a factor of 2 of the paper where the paper's
-        value is > 0 (worst ratio; each entry outside with its z-score against the
-        paper's value, counting the paper's own Poisson error over 1000 frames) and zero
-        missed targets in the Fig. 4 case.
+def _plan(
+    table: str, runs: int | None, clutter_levels: Sequence[int] | None
+) -> tuple[int, list[int], list[tuple[str, int]]]:
+    """Validated options → (runs, Table 2 levels, work units).
+
+    The work units, in order: one per Table 2 row ``("2", n)`` (its frames run through
+    stateful detectors, so a row is not split), one per Table 1 sequence ``("1", s)``
+    (all six gates) and one per case sequence ``(case, s)``.
     """
     if table not in TABLES:
         raise ValueError(f"table: expected one of {', '.join(TABLES)}, got {table!r}")
     n_runs = _check_runs(runs)
     sequences = max(1, n_runs // 10)
-    rng = np.random.default_rng(seed)
-    out = Path(out_dir) if out_dir is not None else None
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
     levels = list(TABLE2_PAPER) if clutter_levels is None else list(clutter_levels)
     for n in levels:
         if n not in TABLE2_PAPER:
@@ -679,15 +666,173 @@ def run(
                 f"({', '.join(map(str, TABLE2_PAPER))})"
             )
     want = set(TABLES[:-1]) if table == "all" else {table}
-    cases = [c for c in CASES if c in want]
-    total = (len(levels) if "2" in want else 0) + (len(TABLE1_PAPER) if "1" in want else 0)
+    units: list[tuple[str, int]] = []
+    if "2" in want:
+        units += [("2", n) for n in levels]
+    if "1" in want:
+        units += [("1", s) for s in range(sequences)]
+    for case in CASES:
+        if case in want:
+            units += [(case, s) for s in range(sequences)]
+    return n_runs, levels, units
+
+
+def units(
+    runs: int | None = None,
+    *,
+    table: str = "2",
+    clutter_levels: Sequence[int] | None = None,
+) -> int:
+    """Number of work units of the experiment (the parallel protocol of
+    :mod:`seawatch.scenarios.parallel`): Table 2 rows, Table 1 and case sequences."""
+    return len(_plan(table, runs, clutter_levels)[2])
+
+
+def unit_costs(
+    runs: int | None = None,
+    *,
+    table: str = "2",
+    clutter_levels: Sequence[int] | None = None,
+) -> FloatArray:
+    """Relative cost of each work unit (for balanced chunks): detector-frames × √(n/100)
+    (measured: about 0.2 ms per detector-frame at n = 100 clutter marks, 0.37 ms at 300).
+    A Table 2 row runs 6 detectors over 14 × runs frames in all, a Table 1 sequence 6
+    gates over 50 frames, a case sequence one detector over 50 frames."""
+    n_runs, _, plan = _plan(table, runs, clutter_levels)
+    cost = []
+    for part, k in plan:
+        if part == "2":
+            frames = 6 * BURN_IN + 2 * (2 + N5_FACTOR) * n_runs
+            cost.append(frames * math.sqrt(k / 100.0))
+        elif part == "1":
+            cost.append(len(TABLE1_PAPER) * TABLE1_FRAMES * math.sqrt(TABLE1_CLUTTER / 100.0))
+        else:
+            cost.append(CASE_FRAMES * math.sqrt(CASE_CLUTTER / 100.0))
+    return np.asarray(cost)
+
+
+@dataclass
+class ClutterChunk:
+    """What :func:`chunk` returns: the results of some work units.
+
+    Attributes:
+        table2: per clutter level n, per-frame new ``tracks`` and ``marks`` per detector
+            key (N, seed exclusion).
+        table1: per sequence s, per large gate g, (false alarms, missed).
+        cases: per (case, sequence), the four per-sequence values of :func:`track_case`.
+    """
+
+    table2: dict[int, dict[str, dict[tuple[int, bool], FloatArray]]] = field(default_factory=dict)
+    table1: dict[int, dict[int, tuple[float, float]]] = field(default_factory=dict)
+    cases: dict[tuple[str, int], dict[str, float]] = field(default_factory=dict)
+
+
+def _rng(seed: int, part: str, k: int) -> np.random.Generator:
+    return np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(_STREAMS[part], k)))
+
+
+def chunk(
+    indices: Sequence[int],
+    runs: int | None = None,
+    seed: int = 0,
+    *,
+    progress: ProgressCallback | None = None,
+    table: str = "2",
+    clutter_levels: Sequence[int] | None = None,
+) -> ClutterChunk:
+    """Work units ``indices`` of the experiment (see :func:`units`; the parallel protocol
+    of :mod:`seawatch.scenarios.parallel`; :func:`run` is ``merge([chunk(all units)])``).
+
+    Unit (part, k) draws from its own stream, ``SeedSequence(seed, spawn_key=(key, k))``
+    with key 2 for Table 2 (k = the clutter level n), 1 for Table 1 and 4, 5, 6 for
+    fig4, crossing, splitting (k = the sequence), so it does not depend on the chunking.
+
+    Args:
+        indices: unit indices, increasing.
+        runs, seed, table, clutter_levels: as in :func:`run`.
+        progress: ``progress(done, total)`` after each Table 2 row, Table 1 gate size and
+            case of the chunk.
+    """
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ValueError(f"seed: expected a non-negative integer, got {seed!r}")
+    n_runs, _, plan = _plan(table, runs, clutter_levels)
+    idx = list(indices)
+    if not idx or any(not 0 <= i < len(plan) for i in idx):
+        raise ValueError(f"indices: expected unit indices in 0 … {len(plan) - 1}, got {indices!r}")
+    mine = [plan[i] for i in idx]
+    t1 = [k for part, k in mine if part == "1"]
+    cases = [c for c in CASES if any(part == c for part, _ in mine)]
+    total = sum(1 for part, _ in mine if part == "2") + (len(TABLE1_PAPER) if t1 else 0)
     total += len(cases)
     done = [0]
+
+    def tick() -> None:
+        done[0] += 1
+        if progress is not None:
+            progress(done[0], total)
+
+    out = ClutterChunk()
+    for part, k in mine:
+        if part == "2":
+            out.table2[k] = _table2_point(k, n_runs, _rng(seed, "2", k))
+            tick()
+    data = {s: _table1_sequence(_rng(seed, "1", s)) for s in t1}
+    for s in t1:
+        out.table1[s] = {}
+    for g in TABLE1_PAPER:  # gate by gate, as the progress reports
+        for s in t1:
+            out.table1[s][g] = _table1_gate(g, *data[s])
+        if t1:
+            tick()
+    for case in cases:
+        seqs = [k for part, k in mine if part == case]
+        res = track_case(case, len(seqs), [_rng(seed, case, k) for k in seqs])
+        for j, k in enumerate(seqs):
+            out.cases[(case, k)] = {m: float(v[j]) for m, v in res.items()}
+        tick()
+    return out
+
+
+def merge(
+    payloads: Sequence[ClutterChunk],
+    runs: int | None = None,
+    seed: int = 0,
+    out_dir: str | Path | None = None,
+    *,
+    table: str = "2",
+    clutter_levels: Sequence[int] | None = None,
+) -> ExperimentResult:
+    """The experiment JSON (and outputs) of :func:`run` from the chunks of :func:`chunk`.
+
+    Args:
+        payloads: chunks covering every work unit once (any order).
+        runs, seed, out_dir, table, clutter_levels: as in :func:`run`.
+    """
+    n_runs, levels, plan = _plan(table, runs, clutter_levels)
+    got = ClutterChunk()
+    for p in payloads:
+        got.table2.update(p.table2)
+        got.table1.update(p.table1)
+        got.cases.update(p.cases)
+    missing = [
+        u
+        for u in plan
+        if (u[0] == "2" and u[1] not in got.table2)
+        or (u[0] == "1" and u[1] not in got.table1)
+        or (u[0] in CASES and u not in got.cases)
+    ]
+    if missing:
+        raise ValueError(f"payloads: {len(missing)} work units missing, e.g. {missing[0]}")
+    want = set(TABLES[:-1]) if table == "all" else {table}
+    sequences = max(1, n_runs // 10)
+    out = Path(out_dir) if out_dir is not None else None
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
     records: list[dict[str, Any]] = []
     outputs: list[Path] = []
     checks: dict[str, Any] = {}
     if "2" in want:
-        recs, rows = _table2(n_runs, levels, rng, progress, done, total)
+        recs, rows = _table2_records(levels, got.table2)
         records += recs
         ratios = [r["ratio"] for r in rows if r["paper"] > 0]
         worst = max(ratios, key=lambda x: abs(math.log(x)) if x > 0 else math.inf)
@@ -709,12 +854,24 @@ def run(
                 )
             )
     if "1" in want:
-        recs, rows = _table1(sequences, rng, progress, done, total)
+        t1 = {
+            g: {
+                "false_total": np.array([got.table1[s][g][0] for s in range(sequences)]),
+                "missed": np.array([got.table1[s][g][1] for s in range(sequences)]),
+            }
+            for g in TABLE1_PAPER
+        }
+        recs, rows = _table1_records(t1)
         records += recs
         if out is not None:
             outputs.append(write_csv(rows, out / "table1.csv"))
+    cases = [c for c in CASES if c in want]
     if cases:
-        recs, rows = _cases(cases, sequences, rng, progress, done, total)
+        res = {
+            c: {m: np.array([got.cases[(c, s)][m] for s in range(sequences)]) for m in CASE_UNITS}
+            for c in cases
+        }
+        recs, rows = _cases_records(res)
         records += recs
         if "fig4" in cases:
             missed = next(
@@ -731,6 +888,45 @@ def run(
         outputs=outputs,
         extra={"checks": checks, "linearity_threshold_px": EPS_PX},
     )
+
+
+def run(
+    table: str = "2",
+    runs: int | None = None,
+    seed: int = 0,
+    out_dir: str | Path | None = None,
+    progress: ProgressCallback | None = None,
+    clutter_levels: Sequence[int] | None = None,
+) -> ExperimentResult:
+    """Run the ``clutter-tbd`` experiment (SCENARIOS.md; seed 004 Tables 1–2, Fig. 4).
+
+    ``merge([chunk(every work unit)])``, the code the parallel runner uses too: its
+    unit of work is a Table 2 row, a Table 1 sequence or a case sequence (:func:`units`),
+    each with its own random stream (:func:`chunk`).
+
+    Args:
+        table: ``"2"``, ``"1"``, ``"fig4"``, ``"crossing"``, ``"splitting"`` or ``"all"``.
+        runs: Monte-Carlo size. Table 2: frames measured per (clutter, N) point after a
+            10-frame burn-in (default 1000, the paper's count; 5× as many for N = 5;
+            about a minute for the whole table). Table 1 and the target cases:
+            ``runs // 10`` independent 50-frame sequences (default 100).
+        seed: the experiment's seed (non-negative; per-unit streams, see :func:`chunk`).
+        out_dir: if given, ``table2.csv`` + ``table2.png``, ``table1.csv`` and
+            ``cases.csv`` are written there.
+        progress: ``progress(done, total)`` after each clutter level, gate size or case.
+        clutter_levels: Table 2 rows to run (default all, 100 … 300 marks per frame).
+
+    Returns:
+        The experiment JSON (INTERFACES.md) as an :class:`ExperimentResult`; ``extra``
+        holds ``"checks"``: Table 2 within a factor of 2 of the paper where the paper's
+        value is > 0 (worst ratio; each entry outside with its z-score against the
+        paper's value, counting the paper's own Poisson error over 1000 frames) and zero
+        missed targets in the Fig. 4 case.
+    """
+    opts: dict[str, Any] = {"table": table, "clutter_levels": clutter_levels}
+    n_runs, _, plan = _plan(table, runs, clutter_levels)
+    payload = chunk(range(len(plan)), n_runs, seed, progress=progress, **opts)
+    return merge([payload], n_runs, seed, out_dir, **opts)
 
 
 def side_by_side(result: ExperimentResult) -> list[dict[str, Any]]:

@@ -53,6 +53,12 @@ durations, the rest is ours):
   ALGORITHMS.md §2); ``late_fading=True`` adds the seed-literal one-step-late order as
   an ablation (estimators ``stkf-late``, ``stereo-stkf-late``).
 
+Randomness: run i of experiment e draws from ``SeedSequence(seed, spawn_key=(e − 1,
+i))`` and every step treats the runs of a batch independently, so a run's numbers do
+not depend on the chunk or Dask worker it runs in (:func:`chunk` / :func:`merge`, the
+protocol of :mod:`seawatch.scenarios.parallel`; :func:`run` is
+``merge([chunk(range(runs))])``).
+
 Metrics (per run: RMS over frames 1…N−1 of the run; records: mean ± standard error over
 runs; all filters see the same noise):
 
@@ -125,7 +131,7 @@ import csv
 import itertools
 import math
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -166,6 +172,17 @@ RANGE_BANDS_M: tuple[tuple[float, float], ...] = (
 """True-range bands [m] of the triangulation comparison."""
 CHUNK_RUNS = 250
 """Monte-Carlo runs processed together (bounds memory; results do not depend on it)."""
+CHUNK_MAX = CHUNK_RUNS
+"""Largest chunk the parallel runner sends to one task (:mod:`seawatch.scenarios.parallel`)."""
+CHUNK_MIN = 50
+"""Smallest chunk of the parallel runner's default plan."""
+PARALLEL_MIN_COST = 200
+"""Below this many runs the default (no ``--workers``) runs in one process (a run costs
+about 0.07 s, a local cluster 5–10 s to start)."""
+CHUNK_ALIGN = 50
+"""The per-frame sums of the plots are taken over aligned blocks of this many runs and
+added in block order, so chunks starting on multiples of 50 give bit-identical outputs
+(the records are per-run values and never depend on the chunking)."""
 COMPARE_EVERY = 10
 """The triangulation comparison uses every 10th frame of every run."""
 
@@ -482,7 +499,9 @@ def simulate_truth(
     if eps.size and N > 1:  # remove the trapezoid-weighted run mean: s_N = v̄ T exactly
         w = np.ones(N)
         w[[0, -1]] = 0.5
-        dv -= (dv @ w)[:, None] / np.sum(w)
+        # (dv * w).sum(1), not dv @ w: BLAS gemv rounds a lone row differently from a
+        # batch, and a run must not depend on the batch it is simulated in
+        dv -= (dv * w).sum(axis=1)[:, None] / np.sum(w)
     v = experiment.speed + dv
     s = np.zeros_like(v)
     s[:, 1:] = np.cumsum(0.5 * DT_S * (v[:, 1:] + v[:, :-1]), axis=1)
@@ -648,14 +667,194 @@ def prediction_errors(batch: FerryBatch, pred: Predictions) -> dict[str, FloatAr
 
 def _run_generators(seed: int, experiment: int, runs: int) -> list[np.random.Generator]:
     """Independent per-run generators: run i's draws do not depend on ``runs``."""
-    children = np.random.SeedSequence(seed).spawn(2)[experiment - 1].spawn(runs)
-    return [np.random.default_rng(c) for c in children]
+    return _generators(seed, experiment, range(runs))
+
+
+def _generators(seed: int, experiment: int, indices: Sequence[int]) -> list[np.random.Generator]:
+    """Run i of experiment e: ``default_rng(SeedSequence(seed, spawn_key=(e − 1, i)))``.
+
+    The same streams as ``SeedSequence(seed).spawn(2)[e − 1].spawn(runs)[i]``.
+    """
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ValueError(f"seed: expected a non-negative integer, got {seed!r}")
+    return [
+        np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(experiment - 1, int(i))))
+        for i in indices
+    ]
 
 
 # ----------------------------------------------------------------------------- experiment
 def _window_mask(N: int) -> NDArray[np.bool_]:
     t = np.arange(1, N) * DT_S
     return t <= VIDEO_WINDOW_S + 1e-9
+
+
+@dataclass
+class FerryChunk:
+    """What :func:`chunk` computes for one experiment and a chunk of runs.
+
+    Attributes:
+        runs: global run indices, (B,).
+        per_run: per (estimator, metric, "run" | "window"), the per-run RMS (B,).
+        tri: per (metric, method, band index), the per-run value (B,) (NaN where the run
+            has no frame in the band) and the run's frame count in the band (B,).
+        sumsq: per (estimator, metric), sums over runs of the squared error per frame,
+            one (N−1,) array per aligned block of :data:`CHUNK_ALIGN` runs, in order.
+        nis_sum, nis_n, fading_sum, faded: per estimator, per-run sums over frames of
+            the NIS and of the fading factor, frame counts and frames with fading > 1,
+            each (B,).
+    """
+
+    runs: NDArray[np.int64]
+    per_run: dict[tuple[str, str, str], FloatArray]
+    tri: dict[tuple[str, str, int], tuple[FloatArray, NDArray[np.int64]]]
+    sumsq: dict[tuple[str, str], list[FloatArray]]
+    nis_sum: dict[str, FloatArray]
+    nis_n: dict[str, NDArray[np.int64]]
+    fading_sum: dict[str, FloatArray]
+    faded: dict[str, NDArray[np.int64]]
+
+
+def _chunk_experiment(
+    experiment: FerryExperiment,
+    indices: NDArray[np.int64],
+    seed: int,
+    late_fading: bool,
+    progress: Callable[[int], None] | None = None,
+    block: int = CHUNK_RUNS,
+) -> FerryChunk:
+    """Runs ``indices`` of one experiment, vectorised over blocks of ``block`` runs."""
+    estimators = ESTIMATORS + (LATE_ESTIMATORS if late_fading else ())
+    geo = ferry_geometry()
+    N = experiment.frames
+    # the window is a prefix of the frames: a slice keeps each row's reduction the same
+    # whatever the batch (a boolean mask gives a Fortran-ordered copy)
+    n_window = int(np.count_nonzero(_window_mask(N)))
+    per_run: dict[tuple[str, str, str], list[FloatArray]] = {}
+    tri: dict[tuple[str, str, int], list[tuple[FloatArray, NDArray[np.int64]]]] = {}
+    sumsq: dict[tuple[str, str], list[FloatArray]] = {}
+    diag: dict[str, dict[str, list[FloatArray]]] = {
+        k: {} for k in ("nis_sum", "nis_n", "fading_sum", "faded")
+    }
+    for lo in range(0, indices.size, block):
+        runs = indices[lo : lo + block]
+        gens = _generators(seed, experiment.number, runs.tolist())
+        batch = simulate_batch(experiment, gens, geo, compare=True, compare_every=COMPARE_EVERY)
+        key = runs // CHUNK_ALIGN
+        cuts = [0, *(np.nonzero(np.diff(key))[0] + 1).tolist(), runs.size]
+        blocks = [slice(a, b) for a, b in itertools.pairwise(cuts)]
+        true_range = geo.ranges(batch.truth.along[:, ::COMPARE_EVERY])
+        for method, err in batch.range_error.items():
+            for i, (r0, r1) in enumerate(RANGE_BANDS_M):
+                sel = (true_range >= r0) & (true_range < r1)
+                cnt = np.sum(sel, axis=1)
+                e = np.where(sel, err, np.nan)
+                with warnings.catch_warnings(action="ignore", category=RuntimeWarning):
+                    values = {
+                        "bias_range": np.nanmean(e, axis=1),
+                        "rmse_range": np.sqrt(np.nanmean(e * e, axis=1)),
+                        "median_error_range": np.nanmedian(e, axis=1),
+                    }
+                for metric, v in values.items():
+                    tri.setdefault((metric, method, i), []).append((v, cnt))
+        for est in estimators:
+            pred = run_filter(est, experiment, batch.z, batch.R)
+            errs = prediction_errors(batch, pred)
+            for metric, e in errs.items():
+                e2 = e * e
+                per_run.setdefault((est, metric, "run"), []).append(np.sqrt(np.mean(e2, axis=1)))
+                per_run.setdefault((est, metric, "window"), []).append(
+                    np.sqrt(np.mean(e2[:, :n_window], axis=1))
+                )
+                sumsq.setdefault((est, metric), []).extend(e2[b].sum(axis=0) for b in blocks)
+            diag["nis_sum"].setdefault(est, []).append(np.sum(pred.nis, axis=1))
+            diag["nis_n"].setdefault(est, []).append(np.full(runs.size, pred.nis.shape[1]))
+            diag["fading_sum"].setdefault(est, []).append(np.sum(pred.fading, axis=1))
+            diag["faded"].setdefault(est, []).append(np.count_nonzero(pred.fading > 1.0, axis=1))
+        if progress is not None:
+            progress(runs.size)
+    return FerryChunk(
+        runs=indices,
+        per_run={k: np.concatenate(v) for k, v in per_run.items()},
+        tri={
+            k: (np.concatenate([a for a, _ in v]), np.concatenate([c for _, c in v]))
+            for k, v in tri.items()
+        },
+        sumsq=sumsq,
+        **{name: {k: np.concatenate(v) for k, v in d.items()} for name, d in diag.items()},
+    )
+
+
+def _merge_experiment(
+    experiment: FerryExperiment, payloads: Sequence[FerryChunk], late_fading: bool
+) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+    """Records and plot series of one experiment from its chunks (in run order)."""
+    estimators = ESTIMATORS + (LATE_ESTIMATORS if late_fading else ())
+    runs = int(sum(p.runs.size for p in payloads))
+    N = experiment.frames
+    geo = ferry_geometry()
+
+    def cat(get: Callable[[FerryChunk], Any]) -> Any:
+        return np.concatenate([get(p) for p in payloads])
+
+    e_no = experiment.number
+    records: list[dict[str, Any]] = []
+    for window_key, params in (
+        ("run", {"experiment": e_no}),
+        ("window", {"experiment": e_no, "window_s": [0.0, VIDEO_WINDOW_S]}),
+    ):
+        for est in estimators:
+            for i, (metric, unit) in enumerate(PRED_METRICS):
+                paper = None
+                if window_key == "run" and i < 2 and est in experiment.paper:
+                    paper = experiment.paper[est][i]
+                vals = cat(lambda p, k=(est, metric, window_key): p.per_run[k])
+                records.append(record(est, metric, unit, vals, paper=paper, params=params))
+    for metric in RANGE_METRICS:
+        for method in TRIANGULATIONS:
+            for i, band in enumerate(RANGE_BANDS_M):
+                key = (metric, method, i)
+                if not any(np.any(p.tri[key][1]) for p in payloads):
+                    continue  # no run has a frame in this band
+                vals = cat(lambda p, k=key: p.tri[k][0][p.tri[k][1] > 0])
+                hi = band[1] if math.isfinite(band[1]) else None
+                records.append(
+                    record(
+                        f"triangulation-{method}",
+                        metric,
+                        "m",
+                        vals,
+                        params={"experiment": e_no, "range_m": [band[0], hi]},
+                    )
+                )
+    rms: dict[tuple[str, str], FloatArray] = {}
+    for k in payloads[0].sumsq:
+        parts = [part for p in payloads for part in p.sumsq[k]]
+        total = parts[0].copy()
+        for part in parts[1:]:
+            total += part
+        rms[k] = np.sqrt(total / runs)
+    n = {k: int(np.sum(cat(lambda p, k=k: p.nis_n[k]))) for k in estimators}
+    series: dict[str, Any] = {
+        "time": np.arange(1, N) * DT_S,
+        "sqrt_R": np.sqrt(along_track_variance(geo, experiment.speed * np.arange(1, N) * DT_S)),
+        "range": geo.ranges(experiment.speed * np.arange(N) * DT_S)[1:],
+        "rms": rms,
+        "diagnostics": {
+            "mean_nis": {
+                k: float(np.sum(cat(lambda p, k=k: p.nis_sum[k]))) / max(n[k], 1)
+                for k in estimators
+            },
+            "mean_fading_factor": {
+                k: float(np.sum(cat(lambda p, k=k: p.fading_sum[k]))) / max(n[k], 1)
+                for k in estimators
+            },
+            "fading_fraction": {
+                k: int(np.sum(cat(lambda p, k=k: p.faded[k]))) / max(n[k], 1) for k in estimators
+            },
+        },
+    }
+    return records, series
 
 
 def run_experiment(
@@ -669,107 +868,25 @@ def run_experiment(
     progress_total: int | None = None,
     chunk: int = CHUNK_RUNS,
 ) -> tuple[list[dict[str, Any]], dict[str, Any]]:
-    """Monte-Carlo runs of one experiment, in chunks of ``chunk`` runs.
+    """Monte-Carlo runs of one experiment, in blocks of ``chunk`` runs.
 
     Returns:
         (records, series): the experiment-JSON records and, for the plots, the RMS over
         runs of each prediction error per frame (``series[(estimator, metric)]``, (N−1,)),
         the truth's time axis and the nominal √R.
     """
-    estimators = ESTIMATORS + (LATE_ESTIMATORS if late_fading else ())
-    gens = _run_generators(seed, experiment.number, runs)
-    geo = ferry_geometry()
-    N = experiment.frames
-    window = _window_mask(N)
-    per_run: dict[tuple[str, str, str], list[FloatArray]] = {}
-    sumsq: dict[tuple[str, str], FloatArray] = {}
-    tri: dict[tuple[str, str, int], list[FloatArray]] = {}
-    nis_sum = dict.fromkeys(estimators, 0.0)
-    nis_n = dict.fromkeys(estimators, 0)
-    lam_sum = dict.fromkeys(estimators, 0.0)
-    faded = dict.fromkeys(estimators, 0)
     total = progress_total if progress_total is not None else runs
-    nominal_range = geo.ranges(experiment.speed * np.arange(N) * DT_S)
-    for lo in range(0, runs, chunk):
-        batch = simulate_batch(
-            experiment, gens[lo : lo + chunk], geo, compare=True, compare_every=COMPARE_EVERY
-        )
-        B = batch.z.shape[0]
-        true_range = geo.ranges(batch.truth.along[:, ::COMPARE_EVERY])
-        for method, err in batch.range_error.items():
-            for i, (r0, r1) in enumerate(RANGE_BANDS_M):
-                sel = (true_range >= r0) & (true_range < r1)
-                cnt = np.sum(sel, axis=1)
-                if not np.any(cnt):
-                    continue
-                e = np.where(sel, err, np.nan)
-                with warnings.catch_warnings(action="ignore", category=RuntimeWarning):
-                    tri.setdefault(("bias_range", method, i), []).append(np.nanmean(e, axis=1))
-                    tri.setdefault(("rmse_range", method, i), []).append(
-                        np.sqrt(np.nanmean(e * e, axis=1))
-                    )
-                    tri.setdefault(("median_error_range", method, i), []).append(
-                        np.nanmedian(e, axis=1)
-                    )
-        for est in estimators:
-            pred = run_filter(est, experiment, batch.z, batch.R)
-            errs = prediction_errors(batch, pred)
-            for metric, e in errs.items():
-                e2 = e * e
-                per_run.setdefault((est, metric, "run"), []).append(np.sqrt(np.mean(e2, axis=1)))
-                per_run.setdefault((est, metric, "window"), []).append(
-                    np.sqrt(np.mean(e2[:, window], axis=1))
-                )
-                acc = sumsq.setdefault((est, metric), np.zeros(N - 1))
-                acc += np.sum(e2, axis=0)
-            nis_sum[est] += float(np.sum(pred.nis))
-            nis_n[est] += pred.nis.size
-            lam_sum[est] += float(np.sum(pred.fading))
-            faded[est] += int(np.count_nonzero(pred.fading > 1.0))
-        if progress is not None:
-            progress(progress_offset + lo + B, total)
+    done = [progress_offset]
 
-    e_no = experiment.number
-    records: list[dict[str, Any]] = []
-    for window_key, params in (
-        ("run", {"experiment": e_no}),
-        ("window", {"experiment": e_no, "window_s": [0.0, VIDEO_WINDOW_S]}),
-    ):
-        for est in estimators:
-            for i, (metric, unit) in enumerate(PRED_METRICS):
-                paper = None
-                if window_key == "run" and i < 2 and est in experiment.paper:
-                    paper = experiment.paper[est][i]
-                vals = np.concatenate(per_run[(est, metric, window_key)])
-                records.append(record(est, metric, unit, vals, paper=paper, params=params))
-    for metric in RANGE_METRICS:
-        for method in TRIANGULATIONS:
-            for i, band in enumerate(RANGE_BANDS_M):
-                if (metric, method, i) not in tri:
-                    continue
-                vals = np.concatenate(tri[(metric, method, i)])
-                hi = band[1] if math.isfinite(band[1]) else None
-                records.append(
-                    record(
-                        f"triangulation-{method}",
-                        metric,
-                        "m",
-                        vals,
-                        params={"experiment": e_no, "range_m": [band[0], hi]},
-                    )
-                )
-    series: dict[str, Any] = {
-        "time": np.arange(1, N) * DT_S,
-        "sqrt_R": np.sqrt(along_track_variance(geo, experiment.speed * np.arange(1, N) * DT_S)),
-        "range": nominal_range[1:],
-        "rms": {k: np.sqrt(v / runs) for k, v in sumsq.items()},
-        "diagnostics": {
-            "mean_nis": {k: nis_sum[k] / max(nis_n[k], 1) for k in estimators},
-            "mean_fading_factor": {k: lam_sum[k] / max(nis_n[k], 1) for k in estimators},
-            "fading_fraction": {k: faded[k] / max(nis_n[k], 1) for k in estimators},
-        },
-    }
-    return records, series
+    def step(n: int) -> None:
+        done[0] += n
+        if progress is not None:
+            progress(done[0], total)
+
+    payload = _chunk_experiment(
+        experiment, np.arange(runs), seed, late_fading, step, block=max(1, int(chunk))
+    )
+    return _merge_experiment(experiment, [payload], late_fading)
 
 
 def ordering(
@@ -804,6 +921,116 @@ def _check_runs(runs: int) -> int:
     return int(runs)
 
 
+def _numbers(experiment: int | None) -> list[int]:
+    if experiment is None:
+        return [1, 2]
+    if experiment in EXPERIMENTS and not isinstance(experiment, bool):
+        return [int(experiment)]
+    raise ValueError(f"experiment: expected 1, 2 or None (both), got {experiment!r}")
+
+
+def chunk(
+    indices: Sequence[int],
+    runs: int | None = None,
+    seed: int = 0,
+    *,
+    progress: ProgressCallback | None = None,
+    experiment: int | None = None,
+    late_fading: bool = False,
+) -> dict[int, FerryChunk]:
+    """Runs ``indices`` of each experiment (the parallel protocol of
+    :mod:`seawatch.scenarios.parallel`; :func:`run` is ``merge([chunk(range(runs))])``).
+
+    Run i of experiment e draws from ``SeedSequence(seed, spawn_key=(e − 1, i))`` and
+    the filters treat runs independently, so a run's values do not depend on its chunk.
+
+    Args:
+        indices: global run indices, increasing.
+        runs: total number of runs (unused: a run does not depend on it).
+        seed: seed of the per-run streams.
+        progress: ``progress(done, total)`` after each block of runs (total = the
+            chunk's runs × the number of experiments).
+        experiment, late_fading: as in :func:`run`.
+
+    Returns:
+        ``{experiment number: FerryChunk}``.
+    """
+    numbers = _numbers(experiment)
+    idx = np.asarray(list(indices), dtype=np.int64)
+    if idx.ndim != 1 or idx.size == 0 or idx[0] < 0 or np.any(np.diff(idx) <= 0):
+        raise ValueError(f"indices: expected increasing non-negative run indices, got {indices!r}")
+    total = idx.size * len(numbers)
+    done = [0]
+
+    def step(n: int) -> None:
+        done[0] += n
+        if progress is not None:
+            progress(done[0], total)
+
+    return {
+        e: _chunk_experiment(EXPERIMENTS[e], idx, int(seed), late_fading, step) for e in numbers
+    }
+
+
+def merge(
+    payloads: Sequence[dict[int, FerryChunk]],
+    runs: int | None = None,
+    seed: int = 0,
+    out_dir: str | Path | None = None,
+    *,
+    experiment: int | None = None,
+    late_fading: bool = False,
+) -> ExperimentResult:
+    """The experiment JSON (and outputs) of :func:`run` from the chunks of :func:`chunk`.
+
+    Args:
+        payloads: the chunks, in run order, covering runs 0 … runs − 1.
+        runs: the number of runs (checked against the chunks).
+        seed: the seed the chunks were made with.
+        out_dir: where ``table3.csv``, ``triangulation.csv`` and the plots go.
+        experiment, late_fading: the options the chunks were made with.
+    """
+    numbers = _numbers(experiment)
+    if not payloads:
+        raise ValueError("payloads: expected at least one chunk")
+    order = sorted(payloads, key=lambda p: int(p[numbers[0]].runs[0]))
+    n_runs = int(sum(p[numbers[0]].runs.size for p in order))
+    if runs is not None and n_runs != runs:
+        raise ValueError(f"payloads: expected {runs} runs in all, got {n_runs}")
+    out = Path(out_dir) if out_dir is not None else None
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+    records: list[dict[str, Any]] = []
+    outputs: list[Path] = []
+    order_ok: dict[str, Any] = {}
+    diagnostics: dict[str, Any] = {}
+    for e in numbers:
+        exp = EXPERIMENTS[e]
+        recs, series = _merge_experiment(exp, [p[e] for p in order], late_fading)
+        records += recs
+        order_ok[str(e)] = {
+            "run": ordering(recs, e),
+            "window_16s": ordering(recs, e, window=True),
+        }
+        diagnostics[str(e)] = series["diagnostics"]
+        if out is not None:
+            for path in (
+                write_table3(records, out / "table3.csv"),
+                write_triangulation(records, out / "triangulation.csv"),
+                plot_prediction_errors(series, exp, out / f"prediction_error_exp{e}.png", n_runs),
+            ):
+                if path not in outputs:
+                    outputs.append(path)
+    return ExperimentResult(
+        SCENARIO,
+        n_runs,
+        int(seed),
+        records,
+        outputs=outputs,
+        extra={"ordering": order_ok, "diagnostics": diagnostics},
+    )
+
+
 def run(
     runs: int = 1000,
     seed: int = 0,
@@ -813,6 +1040,8 @@ def run(
     late_fading: bool = False,
 ) -> ExperimentResult:
     """Run ``seawatch experiment stereo-ferry`` (SCENARIOS.md; seed 003 Table 3).
+
+    ``merge([chunk(range(runs))])``: the code the parallel runner uses too.
 
     Args:
         runs: Monte-Carlo runs per experiment (the paper: 1000).
@@ -835,50 +1064,10 @@ def run(
         with a fading factor > 1).
     """
     n_runs = _check_runs(runs)
-    if experiment is None:
-        numbers = [1, 2]
-    elif experiment in EXPERIMENTS and not isinstance(experiment, bool):
-        numbers = [int(experiment)]
-    else:
-        raise ValueError(f"experiment: expected 1, 2 or None (both), got {experiment!r}")
-    out = Path(out_dir) if out_dir is not None else None
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-    records: list[dict[str, Any]] = []
-    outputs: list[Path] = []
-    order: dict[str, Any] = {}
-    diagnostics: dict[str, Any] = {}
-    total = n_runs * len(numbers)
-    for j, e in enumerate(numbers):
-        exp = EXPERIMENTS[e]
-        recs, series = run_experiment(
-            exp,
-            n_runs,
-            int(seed),
-            late_fading=late_fading,
-            progress=progress,
-            progress_offset=j * n_runs,
-            progress_total=total,
-        )
-        records += recs
-        order[str(e)] = {"run": ordering(recs, e), "window_16s": ordering(recs, e, window=True)}
-        diagnostics[str(e)] = series["diagnostics"]
-        if out is not None:
-            for p in (
-                write_table3(records, out / "table3.csv"),
-                write_triangulation(records, out / "triangulation.csv"),
-                plot_prediction_errors(series, exp, out / f"prediction_error_exp{e}.png", n_runs),
-            ):
-                if p not in outputs:
-                    outputs.append(p)
-    return ExperimentResult(
-        SCENARIO,
-        n_runs,
-        int(seed),
-        records,
-        outputs=outputs,
-        extra={"ordering": order, "diagnostics": diagnostics},
-    )
+    opts = {"experiment": experiment, "late_fading": late_fading}
+    _numbers(experiment)
+    payload = chunk(range(n_runs), n_runs, seed, progress=progress, **opts)
+    return merge([payload], n_runs, seed, out_dir, **opts)
 
 
 # ----------------------------------------------------------------------------- outputs

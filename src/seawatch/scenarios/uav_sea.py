@@ -27,7 +27,13 @@ Resolved choices (SCENARIOS.md, documented here as required):
 * Randomness: run i draws from ``numpy.random.default_rng(SeedSequence(seed,
   spawn_key=(i,)))`` (process noise, angle noise, platform noise, impulse noise, in that
   order), so a run's numbers do not depend on how runs are split into blocks or
-  workers (:func:`simulate` takes the index of the first run).
+  workers (:func:`simulate` takes the index of the first run; :func:`chunk` and
+  :func:`merge` are the protocol of :mod:`seawatch.scenarios.parallel`, and
+  :func:`run` is ``merge([chunk(range(runs))])``).
+* Swept set-up (``seawatch sweep uav-sea``): ``run(height=…, sigma_azimuth_arcmin=…,
+  sigma_elevation_arcmin=…)`` change the camera height and the angle noise (paper:
+  3 m, 0.88′, 1.56′) in the simulation, the estimators, the bound and the σ_α-relative
+  thresholds; records then carry no paper values.
 
 Estimators (INTERFACES.md names):
 
@@ -133,8 +139,9 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import itertools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -142,7 +149,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from seawatch._validation import FloatArray
+from seawatch._validation import FloatArray, positive
 from seawatch.filters import (
     DiffuseRLS,
     ExtendedKalmanFilter,
@@ -164,8 +171,11 @@ __all__ = [
     "Estimates",
     "Measurements",
     "Trajectory",
+    "UavSeaChunk",
+    "chunk",
     "estimate",
     "geometry_position",
+    "merge",
     "nominal_trajectory",
     "pcrb",
     "run",
@@ -199,7 +209,9 @@ VELOCITY_PRIOR_STD = 10.0
 IMPULSE_WINDOW = (40.0, 42.0)
 IMPULSE_STD = math.radians(1.0)
 RECOVERY_THRESHOLD = 0.5 * SIGMA_AZIMUTH
+"""Impulse recovery threshold σ_α/2 [rad] (scales with σ_α when it is swept)."""
 LOSS_THRESHOLD = 1.5 * SIGMA_AZIMUTH
+"""Loss-of-track threshold 1.5 σ_α [rad] (scales with σ_α when it is swept)."""
 LOSS_START = 5.0
 """Loss of track is looked for from this time on [s] (after the diffuse start)."""
 SMOOTH_STEPS = 11
@@ -211,6 +223,20 @@ STABILITY_MARGIN = 0.05
 """AR forecasts are iterated (seed eq. 20) while every root has modulus < 1.05."""
 CHUNK = 1000
 """Runs processed together (vectorised over runs)."""
+CHUNK_MAX = CHUNK
+"""Largest chunk the parallel runner sends to one task (memory of one vectorised block)."""
+CHUNK_MIN = 250
+"""Smallest chunk of the parallel runner's default plan: the vectorised runs get cheaper
+with the block size (the EKF/UKF's per-step loops are paid once per block): on the
+development machine 260 runs cost 10 s, 1000 runs 25 s in one block."""
+PARALLEL_MIN_COST = 2000
+"""Below this many runs the default (no ``--workers``) runs in one process: 1000 runs
+take 25 s in one block, about what a 2-worker cluster needs with its start-up."""
+CHUNK_ALIGN = 20
+"""Sums over runs (mean range, the bound's information, the plotted error curves) are
+taken over aligned blocks of this many runs, [20 k, 20 k + 20), and the blocks' sums are
+added in block order: chunks that start on multiples of 20 give bit-identical records
+whatever the chunking (:mod:`seawatch.scenarios.parallel` aligns its chunks)."""
 RLS_BLOCK = 250
 """Runs per RLS ``filter`` call: bounds the memory of its (runs, T, 30) forecast array."""
 SUBSET_RUNS = 200
@@ -220,6 +246,8 @@ Monte-Carlo error of 200 runs, and this keeps 1000 runs within a minute."""
 
 ESTIMATORS = ("geometry", "diffuse-rls", "sliding-diffuse-rls", "ekf", "ukf")
 """INTERFACES.md estimator names, in table order (``crlb`` is the bound)."""
+LOSS_ESTIMATORS = ("diffuse-rls", "sliding-diffuse-rls", "ekf", "ukf")
+"""The estimators judged for loss of track at close range (Fig. 6)."""
 
 PAPER_TABLE2: dict[str, dict[str, float]] = {
     "geometry": {
@@ -262,6 +290,28 @@ TABLE_METRICS: tuple[tuple[str, str], ...] = (
 ProgressCallback = Callable[[int, int], None]
 
 
+@dataclass(frozen=True)
+class _Setup:
+    """The swept camera and noise set-up: height h [m], σ_α and σ_β [rad]."""
+
+    height: float = HEIGHT
+    sigma_azimuth: float = SIGMA_AZIMUTH
+    sigma_elevation: float = SIGMA_ELEVATION
+
+    @property
+    def is_paper(self) -> bool:
+        """The paper's set-up (only then are Table 2 and Fig. 6 values attached)."""
+        return self == _Setup()
+
+
+def _setup(height: float, sigma_azimuth_arcmin: float, sigma_elevation_arcmin: float) -> _Setup:
+    """Validated set-up from the user's units (metres, arc-minutes)."""
+    h = positive("height", height)
+    sa = positive("sigma_azimuth_arcmin", sigma_azimuth_arcmin)
+    se = positive("sigma_elevation_arcmin", sigma_elevation_arcmin)
+    return _Setup(h, sa * ARCMIN, se * ARCMIN)
+
+
 # ==========================================================================================
 # truth and measurements
 # ==========================================================================================
@@ -288,20 +338,23 @@ class Trajectory:
     range: FloatArray
 
 
-def _angles(target_xy: FloatArray, platform_xy: FloatArray) -> tuple[FloatArray, ...]:
+def _angles(
+    target_xy: FloatArray, platform_xy: FloatArray, height: float = HEIGHT
+) -> tuple[FloatArray, ...]:
     """Seed eqs. 1–2 without noise: (α [rad], β [rad], horizontal range [m])."""
     ex = target_xy[..., 0] - platform_xy[..., 0]
     ey = target_xy[..., 1] - platform_xy[..., 1]
     p = -ex * math.sin(HEADING) + ey * math.cos(HEADING)
     r = ex * math.cos(HEADING) + ey * math.sin(HEADING)
     k = np.hypot(ex, ey)
-    return np.arctan2(p, r), np.arctan2(HEIGHT, k), k
+    return np.arctan2(p, r), np.arctan2(height, k), k
 
 
-def nominal_trajectory() -> Trajectory:
+def nominal_trajectory(height: float = HEIGHT) -> Trajectory:
     """The resolved geometry, sampled until the target leaves the 70° field of view.
 
-    The last sample is the last one with |α| ≤ 35° (t = 71.2 s, 713 samples).
+    The last sample is the last one with |α| ≤ 35° (t = 71.2 s, 713 samples); ``height``
+    [m] (the camera's) changes the depressions only.
     """
     t_long = np.arange(0, 2000) * DT
     platform = np.asarray(PLATFORM_START) + np.outer(t_long, PLATFORM_VELOCITY)
@@ -309,7 +362,7 @@ def nominal_trajectory() -> Trajectory:
     target = np.concatenate(
         [x0[:2] + np.outer(t_long, x0[2:]), np.broadcast_to(x0[2:], (t_long.size, 2))], axis=1
     )
-    az, el, rng = _angles(target, platform)
+    az, el, rng = _angles(target, platform, height)
     outside = np.nonzero(np.abs(az) > FIELD_OF_VIEW / 2.0)[0]
     T = int(outside[0])
     return Trajectory(
@@ -358,7 +411,15 @@ def _check_runs(runs: object) -> int:
     return int(runs)
 
 
-def simulate(runs: int = 100, seed: int = 0, *, start: int = 0) -> Measurements:
+def simulate(
+    runs: int = 100,
+    seed: int = 0,
+    *,
+    start: int = 0,
+    height: float = HEIGHT,
+    sigma_azimuth: float = SIGMA_AZIMUTH,
+    sigma_elevation: float = SIGMA_ELEVATION,
+) -> Measurements:
     """Simulate runs ``start … start + runs − 1`` of the scenario (vectorised over runs).
 
     Truth: the NCV target ``x_{k+1} = F x_k + Γ w_k``, ``w_k ~ N(0, σ_a² I)``,
@@ -371,23 +432,36 @@ def simulate(runs: int = 100, seed: int = 0, *, start: int = 0) -> Measurements:
         runs: number of runs B ≥ 1.
         seed: the experiment's seed (non-negative integer).
         start: global index of the first run.
+        height: camera height h [m].
+        sigma_azimuth, sigma_elevation: σ_α, σ_β [rad].
 
     Returns:
         Measurements of shape (B, T, ...), T = 713.
     """
     B = _check_runs(runs)
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise ValueError(f"seed: expected a non-negative integer, got {seed!r}")
     if isinstance(start, bool) or not isinstance(start, int | np.integer) or start < 0:
         raise ValueError(f"start: expected a non-negative integer, got {start!r}")
-    nominal = nominal_trajectory()
+    setup = _Setup(
+        positive("height", height),
+        positive("sigma_azimuth", sigma_azimuth),
+        positive("sigma_elevation", sigma_elevation),
+    )
+    return _simulate_runs(np.arange(int(start), int(start) + B), seed, setup)
+
+
+def _simulate_runs(runs: np.ndarray, seed: int, setup: _Setup) -> Measurements:
+    """:func:`simulate` for the global run indices ``runs`` (B,)."""
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ValueError(f"seed: expected a non-negative integer, got {seed!r}")
+    B = runs.size
+    nominal = nominal_trajectory(setup.height)
     T = nominal.time.size
     w = np.empty((B, T - 1, 2))
     n_ang = np.empty((B, T, 2))
     n_plat = np.empty((B, T, 2))
     n_imp = np.empty((B, T, 2))
     for b in range(B):
-        rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(int(start) + b,)))
+        rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(int(runs[b]),)))
         w[b] = rng.standard_normal((T - 1, 2))
         n_ang[b] = rng.standard_normal((T, 2))
         n_plat[b] = rng.standard_normal((T, 2))
@@ -404,19 +478,19 @@ def simulate(runs: int = 100, seed: int = 0, *, start: int = 0) -> Measurements:
     pos[:, 1:] = x0[:2] + np.cumsum(DT * vel[:, :-1] + 0.5 * DT * DT * w, axis=1)
     target = np.concatenate([pos, vel], axis=-1)
     platform = nominal.platform
-    az, el, rng_true = _angles(pos, platform)
+    az, el, rng_true = _angles(pos, platform, setup.height)
     window = (nominal.time >= IMPULSE_WINDOW[0] - 1e-9) & (nominal.time <= IMPULSE_WINDOW[1] + 1e-9)
     impulse = np.where(window[None, :, None], IMPULSE_STD * n_imp, 0.0)
     return Measurements(
         time=nominal.time,
-        runs=np.arange(start, start + B),
+        runs=np.asarray(runs, dtype=np.int64),
         platform_true=platform,
         target=target,
         azimuth_true=az,
         elevation_true=el,
         range_true=rng_true,
-        azimuth=wrap_angle(az + SIGMA_AZIMUTH * n_ang[..., 0]),
-        elevation=el + SIGMA_ELEVATION * n_ang[..., 1],
+        azimuth=wrap_angle(az + setup.sigma_azimuth * n_ang[..., 0]),
+        elevation=el + setup.sigma_elevation * n_ang[..., 1],
         platform=platform + SIGMA_PLATFORM * n_plat,
         impulse=impulse,
     )
@@ -503,7 +577,13 @@ def _shift_forecasts(fc: FloatArray, steps: tuple[int, ...]) -> dict[int, FloatA
 
 
 def initial_state(
-    azimuth: ArrayLike, elevation: ArrayLike, platform: ArrayLike
+    azimuth: ArrayLike,
+    elevation: ArrayLike,
+    platform: ArrayLike,
+    *,
+    height: float = HEIGHT,
+    sigma_azimuth: float = SIGMA_AZIMUTH,
+    sigma_elevation: float = SIGMA_ELEVATION,
 ) -> tuple[FloatArray, FloatArray]:
     """EKF/UKF start from the first measurement: eqs. 3–5 and their first-order covariance.
 
@@ -514,21 +594,22 @@ def initial_state(
     Args:
         azimuth, elevation: first measured angles [rad], (B,).
         platform: first measured platform position [m], (B, 2).
+        height: camera height h [m]; sigma_azimuth, sigma_elevation: σ_α, σ_β [rad].
 
     Returns:
         x0 (B, 4) [m, m/s] and P0 (B, 4, 4).
     """
     a = np.asarray(azimuth, dtype=np.float64)
     b = np.asarray(elevation, dtype=np.float64)
-    pos = geometry_position(a, b, platform)
-    d = HEIGHT / np.tan(b)
+    pos = geometry_position(a, b, platform, height=height)
+    d = height / np.tan(b)
     c, s = np.cos(a + HEADING), np.sin(a + HEADING)
     ga = np.stack([-d * s, d * c], -1)
-    dd = -HEIGHT / np.sin(b) ** 2
+    dd = -height / np.sin(b) ** 2
     gb = np.stack([dd * c, dd * s], -1)
     Pp = (
-        SIGMA_AZIMUTH**2 * ga[..., :, None] * ga[..., None, :]
-        + SIGMA_ELEVATION**2 * gb[..., :, None] * gb[..., None, :]
+        sigma_azimuth**2 * ga[..., :, None] * ga[..., None, :]
+        + sigma_elevation**2 * gb[..., :, None] * gb[..., None, :]
         + SIGMA_PLATFORM**2 * np.eye(2)
     )
     x0 = np.concatenate([pos, np.zeros_like(pos)], axis=-1)
@@ -544,14 +625,23 @@ def _kalman(
     elevation: FloatArray,
     platform: FloatArray,
     forecast_steps: tuple[int, ...],
+    setup: _Setup = _Setup(),
 ) -> Estimates:
     """World-frame EKF/UKF on the angles with the platform noise in R_eff (module docstring)."""
     B, T = azimuth.shape
     z = np.stack([azimuth, elevation], axis=-1)
     F, Q = constant_velocity(2, DT, SIGMA_A)
-    R = np.diag([SIGMA_AZIMUTH**2, SIGMA_ELEVATION**2])
-    x0, P0 = initial_state(azimuth[:, 0], elevation[:, 0], platform[:, 0])
-    base = SeaSurfaceAngles(HEIGHT, platform[:, 0], HEADING)
+    h = setup.height
+    R = np.diag([setup.sigma_azimuth**2, setup.sigma_elevation**2])
+    x0, P0 = initial_state(
+        azimuth[:, 0],
+        elevation[:, 0],
+        platform[:, 0],
+        height=h,
+        sigma_azimuth=setup.sigma_azimuth,
+        sigma_elevation=setup.sigma_elevation,
+    )
+    base = SeaSurfaceAngles(h, platform[:, 0], HEADING)
     cls = ExtendedKalmanFilter if kind == "ekf" else UnscentedKalmanFilter
     flt = cls(F, Q, base, R, x0, P0)
     states = np.empty((B, T, 4))
@@ -570,13 +660,13 @@ def _kalman(
         angles[:, k] = z[:, k] - np.linalg.solve(flt.S, flt.y[..., None])[..., 0] @ R
     forecasts = {}
     if forecast_steps:
-        here = SeaSurfaceAngles(HEIGHT, platform, HEADING)
+        here = SeaSurfaceAngles(h, platform, HEADING)
         now = here(states)
         vel = np.asarray(PLATFORM_VELOCITY)
         for k in forecast_steps:
             ahead = states.copy()
             ahead[..., :2] += k * DT * states[..., 2:]
-            later = SeaSurfaceAngles(HEIGHT, platform + k * DT * vel, HEADING)(ahead)
+            later = SeaSurfaceAngles(h, platform + k * DT * vel, HEADING)(ahead)
             change = later - now
             change[..., 0] = wrap_angle(change[..., 0])
             fa = angles[..., 0] + change[..., 0]
@@ -600,6 +690,9 @@ def estimate(
     *,
     filtered: Literal["fitted", "model"] = DEFAULT_FILTERED,
     forecast_steps: tuple[int, ...] = (),
+    height: float = HEIGHT,
+    sigma_azimuth: float = SIGMA_AZIMUTH,
+    sigma_elevation: float = SIGMA_ELEVATION,
 ) -> Estimates:
     """Run one estimator of the scenario over a block of runs.
 
@@ -610,6 +703,8 @@ def estimate(
         platform: measured platform positions [m], (B, T, 2).
         filtered: filtered-angle form of the RLS algorithms (ALGORITHMS.md §3.4).
         forecast_steps: forecast horizons k [steps] to return (not for ``geometry``).
+        height: camera height h [m] (eqs. 3–5 and the EKF/UKF measurement model).
+        sigma_azimuth, sigma_elevation: σ_α, σ_β [rad] of the EKF/UKF's R.
 
     Returns:
         Estimates (B, T, …).
@@ -626,8 +721,13 @@ def estimate(
         )
     if filtered not in ("fitted", "model"):
         raise ValueError(f"filtered: expected 'fitted' or 'model', got {filtered!r}")
+    setup = _Setup(
+        positive("height", height),
+        positive("sigma_azimuth", sigma_azimuth),
+        positive("sigma_elevation", sigma_elevation),
+    )
     if name == "geometry":
-        return Estimates(geometry_position(a, b, p), a, b)
+        return Estimates(geometry_position(a, b, p, height=setup.height), a, b)
     if name in ("diffuse-rls", "sliding-diffuse-rls"):
         fa, fb = _rls(name, filtered)
         J = max(forecast_steps) if forecast_steps else None
@@ -645,13 +745,23 @@ def estimate(
                 for k in forecast_steps:
                     forecasts[k][0][blk] = sa[k]
                     forecasts[k][1][blk] = sb[k]
-        return Estimates(geometry_position(fil_a, fil_b, p), fil_a, fil_b, forecasts)
+        return Estimates(
+            geometry_position(fil_a, fil_b, p, height=setup.height), fil_a, fil_b, forecasts
+        )
     if name in ("ekf", "ukf"):
-        return _kalman(name, a, b, p, tuple(forecast_steps))
+        return _kalman(name, a, b, p, tuple(forecast_steps), setup)
     raise ValueError(f"name: unknown estimator {name!r}; expected one of {', '.join(ESTIMATORS)}")
 
 
-def pcrb(target: ArrayLike, platform: ArrayLike, *, platform_noise: bool = True) -> PCRBResult:
+def pcrb(
+    target: ArrayLike,
+    platform: ArrayLike,
+    *,
+    platform_noise: bool = True,
+    height: float = HEIGHT,
+    sigma_azimuth: float = SIGMA_AZIMUTH,
+    sigma_elevation: float = SIGMA_ELEVATION,
+) -> PCRBResult:
     """The scenario's PCRB (module docstring, ``crlb``) averaged over the given truths.
 
     Args:
@@ -659,20 +769,24 @@ def pcrb(target: ArrayLike, platform: ArrayLike, *, platform_noise: bool = True)
         platform: true platform positions (T, 2) [m].
         platform_noise: include the 1 m platform-position noise (False: the looser bound
             with the platform known).
+        height: camera height h [m]; sigma_azimuth, sigma_elevation: σ_α, σ_β [rad].
     """
-    info = _information(np.asarray(target, dtype=np.float64), platform, platform_noise)
+    setup = _Setup(height, sigma_azimuth, sigma_elevation)
+    info = _information(np.asarray(target, dtype=np.float64), platform, platform_noise, setup)
     return _bound_from_information(info)
 
 
-def _information(target: FloatArray, platform: ArrayLike, platform_noise: bool) -> FloatArray:
+def _information(
+    target: FloatArray, platform: ArrayLike, platform_noise: bool, setup: _Setup = _Setup()
+) -> FloatArray:
     cov = SIGMA_PLATFORM**2 * np.eye(2) if platform_noise else None
     return sea_surface_angles_information(
         target,
         platform,
         HEADING,
-        HEIGHT,
-        SIGMA_AZIMUTH,
-        SIGMA_ELEVATION,
+        setup.height,
+        setup.sigma_azimuth,
+        setup.sigma_elevation,
         observer_cov=cov,
     )
 
@@ -719,12 +833,19 @@ def _forecast_metrics(est: Estimates, meas: Measurements) -> dict[int, tuple[Flo
     return out
 
 
-def recovery_time(clean: ArrayLike, impulsive: ArrayLike, time: ArrayLike) -> FloatArray:
+def recovery_time(
+    clean: ArrayLike,
+    impulsive: ArrayLike,
+    time: ArrayLike,
+    *,
+    threshold: float = RECOVERY_THRESHOLD,
+) -> FloatArray:
     """Per run: seconds after the impulse ends until |α̂_impulse − α̂_clean| ≤ σ_α/2 for good.
 
     Args:
         clean, impulsive: azimuth estimates without and with the impulse [rad], (B, T).
         time: sample times [s], (T,).
+        threshold: σ_α/2 [rad].
 
     Returns:
         (B,) [s]; a run that has not settled by the last sample gets the time left in
@@ -733,7 +854,7 @@ def recovery_time(clean: ArrayLike, impulsive: ArrayLike, time: ArrayLike) -> Fl
     t = np.asarray(time, dtype=np.float64)
     excess = np.abs(wrap_angle(np.asarray(impulsive) - np.asarray(clean)))
     after = t >= IMPULSE_WINDOW[1] - 1e-9
-    bad = (excess > RECOVERY_THRESHOLD) & after[None, :]
+    bad = (excess > threshold) & after[None, :]
     idx = np.arange(t.size)
     last = np.max(np.where(bad, idx[None, :], -1), axis=1)
     end = IMPULSE_WINDOW[1]
@@ -742,13 +863,20 @@ def recovery_time(clean: ArrayLike, impulsive: ArrayLike, time: ArrayLike) -> Fl
     return settle - end
 
 
-def loss_of_track_range(squared_error: ArrayLike, range_m: ArrayLike, time: ArrayLike) -> float:
+def loss_of_track_range(
+    squared_error: ArrayLike,
+    range_m: ArrayLike,
+    time: ArrayLike,
+    *,
+    threshold: float = LOSS_THRESHOLD,
+) -> float:
     """Range [m] at which an algorithm loses track (module docstring, Fig. 6 criterion).
 
     Args:
         squared_error: mean over runs of the squared azimuth error [rad²], (T,).
         range_m: mean true range [m], (T,).
         time: sample times [s], (T,).
+        threshold: 1.5 σ_α [rad].
 
     Returns:
         The true range where the 1-s moving RMS first exceeds 1.5 σ_α (t ≥ 5 s), or the
@@ -761,7 +889,7 @@ def loss_of_track_range(squared_error: ArrayLike, range_m: ArrayLike, time: Arra
     smooth = np.sqrt(np.convolve(e2, kernel, mode="same"))
     half = SMOOTH_STEPS // 2
     valid = (t >= LOSS_START) & (np.arange(t.size) < t.size - half)
-    over = np.nonzero(valid & (smooth > LOSS_THRESHOLD))[0]
+    over = np.nonzero(valid & (smooth > threshold))[0]
     return float(r[over[0]]) if over.size else float(r[-1])
 
 
@@ -771,49 +899,105 @@ def loss_of_track_range(squared_error: ArrayLike, range_m: ArrayLike, time: Arra
 
 
 @dataclass
-class _Accumulator:
-    """Per-run metrics and per-time sums collected chunk by chunk."""
+class UavSeaChunk:
+    """What :func:`chunk` returns for a chunk of runs (a Dask task's payload).
+
+    Attributes:
+        T: samples per run.
+        runs: global indices of the runs, in order.
+        metrics: per (estimator, metric, case), per-run values (one array per block of
+            up to :data:`CHUNK` runs; the extras only for runs < :data:`SUBSET_RUNS`).
+        sums: per key, sums over the runs of each aligned block of :data:`CHUNK_ALIGN`
+            runs, in block order: ``range`` (T,) [m], ``info``/``info_known`` (T, 4, 4)
+            (the bound's information, with/without the platform noise),
+            ``sq_pos/<estimator>`` [m²] and ``sq_az/<estimator>[/impulse]`` [rad²] (T,).
+        az_err2_runs: per estimator, the per-run squared azimuth error [rad²], (B, T)
+            (the loss-of-track groups need them run by run).
+        sample: run 0's azimuth error curves [rad] (T,), if run 0 is in the chunk.
+    """
 
     T: int
+    runs: list[np.ndarray] = field(default_factory=list)
     metrics: dict[tuple[str, str, str], list[FloatArray]] = field(default_factory=dict)
-    sq_pos: dict[str, FloatArray] = field(default_factory=dict)
-    sq_az: dict[str, FloatArray] = field(default_factory=dict)
+    sums: dict[str, list[FloatArray]] = field(default_factory=dict)
     az_err2_runs: dict[str, list[FloatArray]] = field(default_factory=dict)
     sample: dict[str, FloatArray] = field(default_factory=dict)
-    range_sum: FloatArray | None = None
-    info: FloatArray | None = None
-    info_known: FloatArray | None = None
-    count: int = 0
+
+    @property
+    def count(self) -> int:
+        """Number of runs."""
+        return int(sum(r.size for r in self.runs))
 
     def add_metric(self, estimator: str, metric: str, case: str, values: FloatArray) -> None:
         self.metrics.setdefault((estimator, metric, case), []).append(np.asarray(values))
 
     def get(self, estimator: str, metric: str, case: str = "") -> FloatArray:
+        """Per-run values of one metric over every run, in run order."""
         return np.concatenate(self.metrics[(estimator, metric, case)])
 
-    def add_sum(self, store: dict[str, FloatArray], key: str, values: FloatArray) -> None:
-        s = values.sum(axis=0)
-        store[key] = store[key] + s if key in store else s
+    def add_sums(self, key: str, values: FloatArray, blocks: list[slice]) -> None:
+        """Append the sums over runs (axis 0) of ``values`` over each aligned block."""
+        self.sums.setdefault(key, []).extend(values[b].sum(axis=0) for b in blocks)
+
+    def total(self, key: str) -> FloatArray:
+        """Sum over all runs: the block sums added in block order (chunking-independent)."""
+        parts = self.sums[key]
+        out = parts[0].copy()
+        for part in parts[1:]:
+            out += part
+        return out
+
+    @classmethod
+    def combine(cls, payloads: list[UavSeaChunk]) -> UavSeaChunk:
+        """One accumulator holding the chunks' runs in the order given (run order)."""
+        if not payloads:
+            raise ValueError("payloads: expected at least one chunk")
+        out = cls(payloads[0].T)
+        for p in payloads:
+            out.runs += p.runs
+            for k, v in p.metrics.items():
+                out.metrics.setdefault(k, []).extend(v)
+            for k, v in p.sums.items():
+                out.sums.setdefault(k, []).extend(v)
+            for k, v in p.az_err2_runs.items():
+                out.az_err2_runs.setdefault(k, []).extend(v)
+            out.sample.update(p.sample)
+        runs = np.concatenate(out.runs)
+        if np.any(np.diff(runs) <= 0):
+            raise ValueError("payloads: expected chunks of distinct runs in increasing order")
+        return out
+
+
+def _blocks(runs: np.ndarray) -> list[slice]:
+    """Slices of consecutive runs in the same aligned block of :data:`CHUNK_ALIGN` runs."""
+    key = runs // CHUNK_ALIGN
+    cuts = [0, *(np.nonzero(np.diff(key))[0] + 1).tolist(), runs.size]
+    return [slice(a, b) for a, b in itertools.pairwise(cuts)]
 
 
 def _process_chunk(
-    acc: _Accumulator,
+    acc: UavSeaChunk,
     meas: Measurements,
     filtered: str,
     impulse: bool,
     tick: Callable[[], None],
+    setup: _Setup,
 ) -> None:
     alt = "model" if filtered == "fitted" else "fitted"
-    B = meas.runs.size
-    first = meas.runs[0] == 0
-    acc.count += B
-    acc.range_sum = (
-        meas.range_true.sum(0) if acc.range_sum is None else acc.range_sum + meas.range_true.sum(0)
-    )
-    info = _information(meas.target, meas.platform_true, True) * B
-    info_k = _information(meas.target, meas.platform_true, False) * B
-    acc.info = info if acc.info is None else acc.info + info
-    acc.info_known = info_k if acc.info_known is None else acc.info_known + info_k
+    angles = {
+        "height": setup.height,
+        "sigma_azimuth": setup.sigma_azimuth,
+        "sigma_elevation": setup.sigma_elevation,
+    }
+    blocks = _blocks(meas.runs)
+    acc.runs.append(meas.runs)
+    acc.add_sums("range", meas.range_true, blocks)
+    for key, noise in (("info", True), ("info_known", False)):
+        acc.sums.setdefault(key, []).extend(
+            _information(meas.target[b], meas.platform_true, noise, setup) * (b.stop - b.start)
+            for b in blocks
+        )
+    first = np.nonzero(meas.runs == 0)[0]
     clean: dict[str, FloatArray] = {}
     for name in ESTIMATORS:
         steps = () if name == "geometry" else FORECAST_STEPS
@@ -824,6 +1008,7 @@ def _process_chunk(
             meas.platform,
             filtered=filtered,  # type: ignore[arg-type]
             forecast_steps=steps,
+            **angles,
         )
         for metric, values in _table_metrics(est, meas).items():
             acc.add_metric(name, metric, "", values)
@@ -831,13 +1016,14 @@ def _process_chunk(
             acc.add_metric(name, "forecast_error_azimuth", f"steps={k}", fa)
             acc.add_metric(name, "forecast_error_elevation", f"steps={k}", fb)
         ex = meas.target[..., :2] - est.position
-        acc.add_sum(acc.sq_pos, name, np.sum(ex**2, axis=-1))
+        acc.add_sums(f"sq_pos/{name}", np.sum(ex**2, axis=-1), blocks)
         ea2 = wrap_angle(meas.azimuth_true - est.azimuth) ** 2
-        acc.add_sum(acc.sq_az, name, ea2)
-        acc.az_err2_runs.setdefault(name, []).append(ea2)
+        acc.add_sums(f"sq_az/{name}", ea2, blocks)
+        if name in LOSS_ESTIMATORS:
+            acc.az_err2_runs.setdefault(name, []).append(ea2)
         clean[name] = est.azimuth
-        if first:
-            acc.sample[name] = wrap_angle(meas.azimuth_true[0] - est.azimuth[0])
+        if first.size:
+            acc.sample[name] = wrap_angle(meas.azimuth_true[first[0]] - est.azimuth[first[0]])
         tick()
     part = meas.runs < SUBSET_RUNS
     if np.any(part):
@@ -849,27 +1035,30 @@ def _process_chunk(
                 sub.elevation,
                 sub.platform,
                 filtered=alt,  # type: ignore[arg-type]
+                **angles,
             )
             for metric, values in _table_metrics(est, sub).items():
                 acc.add_metric(name, metric, f"filtered={alt}", values)
             tick()
     if not impulse:
         return
+    rec_threshold = 0.5 * setup.sigma_azimuth
     a_imp = wrap_angle(meas.azimuth + meas.impulse[..., 0])
     b_imp = meas.elevation + meas.impulse[..., 1]
     for name in ("diffuse-rls", "sliding-diffuse-rls"):
         # the recovery is judged on the azimuth: filter α alone
         az = _rls(name, filtered)[0].filter(a_imp).filtered
-        acc.add_metric(name, "recovery_time", "impulse", recovery_time(clean[name], az, meas.time))
+        rec = recovery_time(clean[name], az, meas.time, threshold=rec_threshold)
+        acc.add_metric(name, "recovery_time", "impulse", rec)
         ea = wrap_angle(meas.azimuth_true - az)
         acc.add_metric(name, "rmse_azimuth", "impulse", np.sqrt(np.mean(ea**2, axis=1)) / ARCMIN)
-        acc.add_sum(acc.sq_az, f"{name}/impulse", ea**2)
-        if first:
-            acc.sample[f"{name}/impulse"] = ea[0]
+        acc.add_sums(f"sq_az/{name}/impulse", ea**2, blocks)
+        if first.size:
+            acc.sample[f"{name}/impulse"] = ea[first[0]]
         tick()
     if np.any(part):  # the EKF's impulse response, an extra: on the subset only
-        az = estimate("ekf", a_imp[part], b_imp[part], meas.platform[part]).azimuth
-        rec = recovery_time(clean["ekf"][part], az, meas.time)
+        az = estimate("ekf", a_imp[part], b_imp[part], meas.platform[part], **angles).azimuth
+        rec = recovery_time(clean["ekf"][part], az, meas.time, threshold=rec_threshold)
         acc.add_metric("ekf", "recovery_time", "impulse", rec)
         ea = wrap_angle(meas.azimuth_true[part] - az)
         acc.add_metric("ekf", "rmse_azimuth", "impulse", np.sqrt(np.mean(ea**2, axis=1)) / ARCMIN)
@@ -896,6 +1085,123 @@ def _groups(runs: int) -> int:
     return max(1, min(10, runs // 10))
 
 
+def _options(
+    filtered: str | None,
+    height: float,
+    sigma_azimuth_arcmin: float,
+    sigma_elevation_arcmin: float,
+) -> tuple[str, _Setup]:
+    form = DEFAULT_FILTERED if filtered is None else filtered
+    if form not in ("fitted", "model"):
+        raise ValueError(f"filtered: expected 'fitted' or 'model', got {filtered!r}")
+    return form, _setup(height, sigma_azimuth_arcmin, sigma_elevation_arcmin)
+
+
+def _chunk_steps(runs: np.ndarray, impulse: bool) -> int:
+    """Progress steps of :func:`chunk` for these runs (one per estimator pass)."""
+    slabs = range(0, runs.size, CHUNK)
+    steps = len(slabs) * (len(ESTIMATORS) + (2 if impulse else 0))
+    extra = 3 if impulse else 2
+    return steps + extra * sum(1 for lo in slabs if runs[lo] < SUBSET_RUNS)
+
+
+def chunk(
+    indices: Sequence[int],
+    runs: int | None = None,
+    seed: int = 0,
+    *,
+    progress: ProgressCallback | None = None,
+    impulse: bool = True,
+    filtered: Literal["fitted", "model"] | None = None,
+    height: float = HEIGHT,
+    sigma_azimuth_arcmin: float = 0.88,
+    sigma_elevation_arcmin: float = 1.56,
+) -> UavSeaChunk:
+    """Runs ``indices`` of the experiment: the per-run part of :func:`run`.
+
+    The parallel protocol of :mod:`seawatch.scenarios.parallel`: run i draws from its
+    own stream and the estimators treat the runs of a block independently, so a run's
+    values do not depend on the chunk it is in; sums over runs are kept per aligned
+    block of :data:`CHUNK_ALIGN` runs (:class:`UavSeaChunk`). Vectorised over blocks of
+    up to :data:`CHUNK` runs.
+
+    Args:
+        indices: global run indices, increasing.
+        runs: total number of runs (unused: a run does not depend on it).
+        seed: random seed (non-negative integer).
+        progress: ``progress(done, total)`` after each estimator pass.
+        impulse, filtered, height, sigma_azimuth_arcmin, sigma_elevation_arcmin: as in
+            :func:`run`.
+    """
+    form, setup = _options(filtered, height, sigma_azimuth_arcmin, sigma_elevation_arcmin)
+    idx = np.asarray(list(indices), dtype=np.int64)
+    if idx.ndim != 1 or idx.size == 0 or idx[0] < 0 or np.any(np.diff(idx) <= 0):
+        raise ValueError(f"indices: expected increasing non-negative run indices, got {indices!r}")
+    total = _chunk_steps(idx, impulse)
+    done = [0]
+
+    def tick() -> None:
+        done[0] += 1
+        if progress is not None:
+            progress(done[0], total)
+
+    acc = UavSeaChunk(nominal_trajectory(setup.height).time.size)
+    for lo in range(0, idx.size, CHUNK):
+        meas = _simulate_runs(idx[lo : lo + CHUNK], seed, setup)
+        _process_chunk(acc, meas, form, impulse, tick, setup)
+    return acc
+
+
+def merge(
+    payloads: Sequence[UavSeaChunk],
+    runs: int | None = None,
+    seed: int = 0,
+    out_dir: str | Path | None = None,
+    *,
+    impulse: bool = True,
+    filtered: Literal["fitted", "model"] | None = None,
+    height: float = HEIGHT,
+    sigma_azimuth_arcmin: float = 0.88,
+    sigma_elevation_arcmin: float = 1.56,
+) -> ExperimentResult:
+    """The records (and outputs) of :func:`run` from the chunks of :func:`chunk`.
+
+    Args:
+        payloads: the chunks, in run order, covering runs 0 … runs − 1.
+        runs: the number of runs (checked against the chunks).
+        seed: the seed the chunks were made with (reported).
+        out_dir: where the tables and plots go (see :func:`run`).
+        impulse, filtered, height, sigma_azimuth_arcmin, sigma_elevation_arcmin: the
+            options the chunks were made with.
+    """
+    form, setup = _options(filtered, height, sigma_azimuth_arcmin, sigma_elevation_arcmin)
+    acc = UavSeaChunk.combine(list(payloads))
+    n_runs = acc.count
+    if runs is not None and n_runs != runs:
+        raise ValueError(f"payloads: expected {runs} runs in all, got {n_runs}")
+    out = Path(out_dir) if out_dir is not None else None
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+    time = nominal_trajectory(setup.height).time
+    mean_range = acc.total("range") / n_runs
+    bound = _bound_from_information(acc.total("info") / n_runs)
+    bound_known = _bound_from_information(acc.total("info_known") / n_runs)
+    records = _records(acc, bound, bound_known, form, impulse, time, mean_range, setup)
+    outputs: list[Path] = []
+    if out is not None:
+        outputs += _write_outputs(
+            out, acc, records, bound, bound_known, time, mean_range, impulse, form, setup
+        )
+    extra: dict[str, Any] = {"filtered": form, "steps": int(time.size)}
+    if not setup.is_paper:
+        extra["setup"] = {
+            "height": setup.height,
+            "sigma_azimuth_arcmin": setup.sigma_azimuth / ARCMIN,
+            "sigma_elevation_arcmin": setup.sigma_elevation / ARCMIN,
+        }
+    return ExperimentResult(SCENARIO, n_runs, int(seed), records, outputs=outputs, extra=extra)
+
+
 def run(
     runs: int = 100,
     seed: int = 0,
@@ -903,10 +1209,14 @@ def run(
     progress: ProgressCallback | None = None,
     impulse: bool = True,
     filtered: Literal["fitted", "model"] | None = None,
+    height: float = HEIGHT,
+    sigma_azimuth_arcmin: float = 0.88,
+    sigma_elevation_arcmin: float = 1.56,
 ) -> ExperimentResult:
     """Run the ``uav-sea`` experiment: Table 2, the CRLB, forecasts, Figs. 5 and 6.
 
-    Runs are processed in blocks of 1000, vectorised over the runs of a block.
+    ``merge([chunk(range(runs))])`` (the code the parallel runner uses too); runs are
+    processed in blocks of 1000, vectorised over the runs of a block.
 
     Args:
         runs: Monte-Carlo runs (≥ 1; the close-range standard errors need ≥ 20).
@@ -920,54 +1230,46 @@ def run(
         filtered: filtered-angle form of the RLS algorithms (default ``"fitted"``,
             module docstring); the other form is reported with ``params {"filtered":
             …}``.
+        height: camera height h [m] (the paper: 3 m).
+        sigma_azimuth_arcmin, sigma_elevation_arcmin: σ_α, σ_β [arc-minutes] (the
+            paper: 0.88′, 1.56′); the recovery and loss-of-track thresholds scale with
+            σ_α. With any of these three changed the records carry no paper values and
+            ``extra["setup"]`` states them (e.g. for ``seawatch sweep uav-sea --param
+            height=3,10,30``).
 
     Returns:
         ExperimentResult with the records of INTERFACES.md (see the module docstring);
         ``extra`` holds ``filtered`` and the per-step curves' summary ``steps``.
     """
     n_runs = _check_runs(runs)
-    form = DEFAULT_FILTERED if filtered is None else filtered
-    if form not in ("fitted", "model"):
-        raise ValueError(f"filtered: expected 'fitted' or 'model', got {filtered!r}")
-    out = Path(out_dir) if out_dir is not None else None
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-    nominal = nominal_trajectory()
-    T = nominal.time.size
-    chunks = [(s, min(CHUNK, n_runs - s)) for s in range(0, n_runs, CHUNK)]
-    total = len(chunks) * (len(ESTIMATORS) + (2 if impulse else 0)) + 1
-    total += (3 if impulse else 2) * sum(1 for s, _ in chunks if s < SUBSET_RUNS)
-    done = [0]
+    opts: dict[str, Any] = {
+        "impulse": impulse,
+        "filtered": filtered,
+        "height": height,
+        "sigma_azimuth_arcmin": sigma_azimuth_arcmin,
+        "sigma_elevation_arcmin": sigma_elevation_arcmin,
+    }
+    _options(filtered, height, sigma_azimuth_arcmin, sigma_elevation_arcmin)
+    if out_dir is not None:
+        Path(out_dir).mkdir(parents=True, exist_ok=True)
+    all_runs = np.arange(n_runs)
+    slabs = [all_runs[lo : lo + CHUNK] for lo in range(0, n_runs, CHUNK)]
+    total = sum(_chunk_steps(s, impulse) for s in slabs) + 1
+    offset = [0]
 
-    def tick() -> None:
-        done[0] += 1
+    def step(done: int, _total: int) -> None:
         if progress is not None:
-            progress(done[0], total)
+            progress(offset[0] + done, total)
 
-    acc = _Accumulator(T)
-    time = nominal.time
-    for start, size in chunks:
-        meas = simulate(size, seed, start=start)
-        _process_chunk(acc, meas, form, impulse, tick)
-    assert acc.info is not None and acc.info_known is not None and acc.range_sum is not None
-    mean_range = acc.range_sum / acc.count
-    bound = _bound_from_information(acc.info / acc.count)
-    bound_known = _bound_from_information(acc.info_known / acc.count)
-    records = _records(acc, bound, bound_known, form, impulse, time, mean_range)
-    tick()
-    outputs: list[Path] = []
-    if out is not None:
-        outputs += _write_outputs(
-            out, acc, records, bound, bound_known, time, mean_range, impulse, form
-        )
-    return ExperimentResult(
-        SCENARIO,
-        n_runs,
-        int(seed),
-        records,
-        outputs=outputs,
-        extra={"filtered": form, "steps": T},
-    )
+    payloads = []
+    for slab in slabs:
+        payloads.append(chunk(range(int(slab[0]), int(slab[-1]) + 1), n_runs, seed,
+                              progress=step, **opts))  # fmt: skip
+        offset[0] += _chunk_steps(slab, impulse)
+    result = merge(payloads, n_runs, seed, out_dir, **opts)
+    if progress is not None:
+        progress(total, total)
+    return result
 
 
 def _bound_rms(bound: PCRBResult) -> dict[str, float]:
@@ -982,22 +1284,25 @@ def _bound_rms(bound: PCRBResult) -> dict[str, float]:
 
 
 def _records(
-    acc: _Accumulator,
+    acc: UavSeaChunk,
     bound: PCRBResult,
     bound_known: PCRBResult,
     form: str,
     impulse: bool,
     time: FloatArray,
     mean_range: FloatArray,
+    setup: _Setup,
 ) -> list[dict[str, Any]]:
     alt = "model" if form == "fitted" else "fitted"
+    table2 = PAPER_TABLE2 if setup.is_paper else {}
+    loss_paper = PAPER_LOSS_RANGE if setup.is_paper else {}
     recs: list[dict[str, Any]] = []
     for name in ESTIMATORS:
-        paper = PAPER_TABLE2.get(name, {})
+        paper = table2.get(name, {})
         for metric, unit in TABLE_METRICS:
             recs.append(record(name, metric, unit, acc.get(name, metric), paper=paper.get(metric)))
     for name in ("diffuse-rls", "sliding-diffuse-rls"):
-        paper = PAPER_TABLE2.get(name, {})
+        paper = table2.get(name, {})
         for metric, unit in TABLE_METRICS:
             recs.append(
                 record(
@@ -1054,16 +1359,20 @@ def _records(
                 )
             )
     G = _groups(acc.count)
-    for name in ("diffuse-rls", "sliding-diffuse-rls", "ekf", "ukf"):
+    threshold = 1.5 * setup.sigma_azimuth
+    for name in LOSS_ESTIMATORS:
         e2 = np.concatenate(acc.az_err2_runs[name])
-        values = [loss_of_track_range(e2[g::G].mean(axis=0), mean_range, time) for g in range(G)]
+        values = [
+            loss_of_track_range(e2[g::G].mean(axis=0), mean_range, time, threshold=threshold)
+            for g in range(G)
+        ]
         recs.append(
             record(
                 name,
                 "loss_of_track_range",
                 "m",
                 values,
-                paper=PAPER_LOSS_RANGE.get(name),
+                paper=loss_paper.get(name),
                 params={"case": "close-range"},
             )
         )
@@ -1149,7 +1458,7 @@ def _figure(rows: int = 1, height: float = 4.8) -> tuple[Any, Any]:
 
 def _write_outputs(
     out: Path,
-    acc: _Accumulator,
+    acc: UavSeaChunk,
     records: list[dict[str, Any]],
     bound: PCRBResult,
     bound_known: PCRBResult,
@@ -1157,6 +1466,7 @@ def _write_outputs(
     mean_range: FloatArray,
     impulse: bool,
     form: str,
+    setup: _Setup,
 ) -> list[Path]:
     paths = [_write_table2(out / "table2.csv", records, form)]
     n = acc.count
@@ -1164,7 +1474,8 @@ def _write_outputs(
     fig, (ax,) = _figure()
     for name in ESTIMATORS:
         ls = "--" if name == "ukf" else "-"
-        ax.plot(time, np.sqrt(acc.sq_pos[name] / n), color=_COLORS[name], lw=1.2, ls=ls, label=name)
+        rms = np.sqrt(acc.total(f"sq_pos/{name}") / n)
+        ax.plot(time, rms, color=_COLORS[name], lw=1.2, ls=ls, label=name)
     ax.plot(time, bound.rmse_bound((0, 1)), "k-", lw=2.0, label="PCRB (platform noise)")
     ax.plot(time, bound_known.rmse_bound((0, 1)), "k:", lw=1.2, label="PCRB (platform known)")
     ax.set_yscale("log")
@@ -1186,9 +1497,10 @@ def _write_outputs(
         ):
             key = f"{name}/impulse"
             ax.plot(time, acc.sample[key] / ARCMIN, color="0.6", lw=0.8, label="run 0")
-            ax.plot(time, np.sqrt(acc.sq_az[key] / n) / ARCMIN, color=_COLORS[name], lw=1.5,
+            ax.plot(time, np.sqrt(acc.total(f"sq_az/{key}") / n) / ARCMIN, color=_COLORS[name],
+                    lw=1.5,
                     label=f"RMS over {n} runs, with impulse")  # fmt: skip
-            ax.plot(time, np.sqrt(acc.sq_az[name] / n) / ARCMIN, "k--", lw=1.0,
+            ax.plot(time, np.sqrt(acc.total(f"sq_az/{name}") / n) / ARCMIN, "k--", lw=1.0,
                     label="RMS without impulse")  # fmt: skip
             ax.axvspan(*IMPULSE_WINDOW, color="red", alpha=0.15)
             rec = _find(records, name, "recovery_time", case="impulse")
@@ -1204,12 +1516,13 @@ def _write_outputs(
         fig.savefig(paths[-1], dpi=110)
     fig, (ax,) = _figure()
     for name in ("geometry", "diffuse-rls", "sliding-diffuse-rls", "ekf"):
-        ax.plot(mean_range, np.sqrt(acc.sq_az[name] / n) / ARCMIN, color=_COLORS[name], lw=1.2,
+        ax.plot(mean_range, np.sqrt(acc.total(f"sq_az/{name}") / n) / ARCMIN,
+                color=_COLORS[name], lw=1.2,
                 label=name)  # fmt: skip
         if name in PAPER_LOSS_RANGE or name == "ekf":
             rec = _find(records, name, "loss_of_track_range", case="close-range")
             ax.axvline(rec["mean"], color=_COLORS[name], ls=":", lw=1.0)
-    ax.axhline(LOSS_THRESHOLD / ARCMIN, color="k", ls="--", lw=0.8, label="1.5 σ_α")
+    ax.axhline(1.5 * setup.sigma_azimuth / ARCMIN, color="k", ls="--", lw=0.8, label="1.5 σ_α")
     ax.set_xlim(float(mean_range[0]), float(mean_range[-1]))
     ax.set_xlabel("true range [m] (decreasing with time)")
     ax.set_ylabel("RMS azimuth error [′]")
