@@ -21,6 +21,7 @@ from seawatch.cli import (
     sweep_cmds,
     synth_cmds,
     tbd_cmds,
+    track_cmds,
 )
 from seawatch.cli._common import EXIT_FAILED, BadInput, emit_json, err, exit_codes, progress_bar
 
@@ -296,6 +297,7 @@ app.command()(tbd_cmds.tbd)
 app.command()(horizon_cmds.horizon)
 app.command()(detect_cmds.detect)
 app.command()(sweep_cmds.sweep)
+app.command()(track_cmds.track)
 app.add_typer(synth_cmds.app, name="synth")
 
 
