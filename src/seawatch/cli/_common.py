@@ -11,7 +11,7 @@ import json
 import math
 import sys
 import warnings
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, TextIO
@@ -112,6 +112,50 @@ def expected_frames(frame_count: int | None, step: int, max_frames: int | None) 
         return None
     total = max(1, math.ceil(frame_count / step))
     return total if max_frames is None else min(total, max_frames)
+
+
+def frame_records(
+    reader: Any,
+    label: str,
+    process: Callable[[Any], dict[str, Any]],
+    *,
+    output: Path | None,
+    columns: Sequence[str],
+    csv_rows: Callable[[dict[str, Any]], list[list[str]]],
+    total: int | None,
+) -> tuple[list[dict[str, Any]], Exception | None]:
+    """Run ``process(frame) -> record`` over a :class:`~seawatch.io.video.VideoReader`.
+
+    Shared loop of the per-frame commands (``horizon``, ``detect``): a progress bar on
+    stderr, the records kept in memory, ``csv_rows(record)`` appended to ``output`` and
+    flushed frame by frame. A source that fails mid-stream ends the loop and is returned
+    as the failure with the frames before it kept; a failure before the first frame is
+    raised (bad input).
+    """
+    from seawatch.io.video import VideoError
+
+    records: list[dict[str, Any]] = []
+    failure: Exception | None = None
+    sink, writer = open_csv(output, columns)
+    try:
+        with progress_bar() as bar:
+            task = bar.add_task(label, total=total)
+            try:
+                for frame in reader:
+                    rec = process(frame)
+                    records.append(rec)
+                    if writer is not None and sink is not None:
+                        writer.writerows(csv_rows(rec))
+                        sink.flush()
+                    bar.advance(task)
+            except VideoError as exc:
+                if not records:
+                    raise
+                failure = exc
+    finally:
+        if sink is not None:
+            sink.close()
+    return records, failure
 
 
 def progress_bar() -> Progress:

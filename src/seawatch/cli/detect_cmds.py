@@ -37,8 +37,7 @@ from seawatch.cli._common import (
     err,
     exit_codes,
     expected_frames,
-    open_csv,
-    progress_bar,
+    frame_records,
     warnings_to_stderr,
 )
 
@@ -139,7 +138,7 @@ def detect(
 
     Example: [cyan]seawatch detect clip.mp4 --json -o boxes.csv[/]
     """
-    from seawatch.io.video import VideoError, VideoReader
+    from seawatch.io.video import VideoReader
     from seawatch.vision.detect import ClassicalShipDetector, OnnxDetector
 
     with exit_codes(), warnings_to_stderr():
@@ -167,32 +166,16 @@ def detect(
             source, step=step, start=start, end=end, max_frames=max_frames, fps=fps
         )
         horizon_of = _horizon_source(reader, use_horizon)
-        records: list[dict[str, Any]] = []
-        sink, writer = open_csv(output, CSV_COLUMNS)
-        total = expected_frames(reader.frame_count, step, max_frames)
-        failure: Exception | None = None
-        n_boxes = 0
-        try:
-            with progress_bar() as bar:
-                task = bar.add_task(f"detect {Path(source).name or source}", total=total)
-                try:
-                    for frame in reader:
-                        hz = horizon_of(frame)
-                        boxes = detector(frame.image, horizon=hz)
-                        rec = _record(frame, boxes)
-                        records.append(rec)
-                        n_boxes += len(rec["boxes"])
-                        if writer is not None and sink is not None:
-                            writer.writerows(_csv_rows(rec))
-                            sink.flush()
-                        bar.advance(task)
-                except VideoError as exc:
-                    if not records:
-                        raise
-                    failure = exc
-        finally:
-            if sink is not None:
-                sink.close()
+        records, failure = frame_records(
+            reader,
+            f"detect {Path(source).name or source}",
+            lambda frame: _record(frame, detector(frame.image, horizon=horizon_of(frame))),
+            output=output,
+            columns=CSV_COLUMNS,
+            csv_rows=_csv_rows,
+            total=expected_frames(reader.frame_count, step, max_frames),
+        )
+        n_boxes = sum(len(rec["boxes"]) for rec in records)
         err.print(
             f"{len(records)} frame(s), {n_boxes} box(es)"
             + (f", {reader.skipped} corrupt frame(s) skipped" if reader.skipped else "")

@@ -36,8 +36,7 @@ from seawatch.cli._common import (
     err,
     exit_codes,
     expected_frames,
-    open_csv,
-    progress_bar,
+    frame_records,
     warnings_to_stderr,
 )
 
@@ -119,7 +118,7 @@ def horizon(
 
     Example: [cyan]seawatch horizon clip.mp4 --json -o horizon.csv[/]
     """
-    from seawatch.io.video import VideoError, VideoReader
+    from seawatch.io.video import VideoReader
     from seawatch.vision.horizon import HorizonTracker, detect_horizon
 
     with exit_codes(), warnings_to_stderr():
@@ -130,32 +129,21 @@ def horizon(
         )
         use_tracker = (reader.kind not in ("folder", "image")) if smooth is None else smooth
         tracker = HorizonTracker(max_tilt_deg=max_tilt, fps=reader.fps or 25.0)
-        records: list[dict[str, Any]] = []
-        sink, writer = open_csv(output, CSV_COLUMNS)
-        total = expected_frames(reader.frame_count, step, max_frames)
-        failure: Exception | None = None
-        try:
-            with progress_bar() as bar:
-                task = bar.add_task(f"horizon {Path(source).name or source}", total=total)
-                try:
-                    for frame in reader:
-                        if use_tracker:
-                            est = tracker.update(frame.image, frame.time)
-                        else:
-                            est = detect_horizon(frame.image, max_tilt_deg=max_tilt)
-                        rec = _record(frame, est)
-                        records.append(rec)
-                        if writer is not None and sink is not None:
-                            writer.writerow(_csv_row(rec))
-                            sink.flush()
-                        bar.advance(task)
-                except VideoError as exc:
-                    if not records:
-                        raise
-                    failure = exc
-        finally:
-            if sink is not None:
-                sink.close()
+
+        def process(frame: Any) -> dict[str, Any]:
+            if use_tracker:
+                return _record(frame, tracker.update(frame.image, frame.time))
+            return _record(frame, detect_horizon(frame.image, max_tilt_deg=max_tilt))
+
+        records, failure = frame_records(
+            reader,
+            f"horizon {Path(source).name or source}",
+            process,
+            output=output,
+            columns=CSV_COLUMNS,
+            csv_rows=lambda rec: [_csv_row(rec)],
+            total=expected_frames(reader.frame_count, step, max_frames),
+        )
         found = sum(r["found"] for r in records)
         err.print(
             f"{len(records)} frame(s), horizon found in {found}"
