@@ -102,6 +102,30 @@ def covariance(
     return arr
 
 
+def linear_model(
+    F: ArrayLike, H: ArrayLike, Q: ArrayLike, R: ArrayLike, *, transition: str = "F"
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Validated, contiguous (F, H, Q, R) of a linear-Gaussian model.
+
+    F (n, n) square and finite (named ``transition`` in errors, e.g. "A" for the
+    fractional filter), H (m, n) with m ≥ 1, Q (n, n) PSD, R (m, m) positive definite.
+    """
+    F = matrix(transition, F)
+    n = F.shape[0]
+    if F.shape != (n, n) or n == 0:
+        raise ValueError(f"{transition}: expected a square (n, n) matrix, got {F.shape}")
+    H = matrix("H", H, (None, n))
+    m = H.shape[0]
+    if m == 0:
+        raise ValueError("H: expected at least one measurement row, got shape (0, n)")
+    return (
+        np.ascontiguousarray(F),
+        np.ascontiguousarray(H),
+        np.ascontiguousarray(covariance("Q", Q, n)),
+        np.ascontiguousarray(covariance("R", R, m, positive_definite=True)),
+    )
+
+
 def positive(name: str, value: float, *, allow_zero: bool = False) -> float:
     """A finite scalar > 0 (or >= 0 with *allow_zero*)."""
     try:

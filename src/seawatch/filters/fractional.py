@@ -47,7 +47,7 @@ from seawatch._validation import (
     covariance,
     finite,
     in_range,
-    matrix,
+    linear_model,
     positive,
 )
 from seawatch.filters import _kalman_kernels as _kk
@@ -368,18 +368,8 @@ class FractionalKalmanFilter:
         memory: int = 30,
         relative: bool = True,
     ) -> None:
-        A = matrix("A", A)
-        n = A.shape[0]
-        if A.shape != (n, n) or n == 0:
-            raise ValueError(f"A: expected a square (n, n) matrix, got {A.shape}")
-        H = matrix("H", H, (None, n))
-        m = H.shape[0]
-        if m == 0:
-            raise ValueError("H: expected at least one measurement row, got shape (0, n)")
-        self.A: FloatArray = np.ascontiguousarray(A)
-        self.H: FloatArray = np.ascontiguousarray(H)
-        self.Q: FloatArray = np.ascontiguousarray(covariance("Q", Q, n))
-        self.R: FloatArray = np.ascontiguousarray(covariance("R", R, m, positive_definite=True))
+        self.A, self.H, self.Q, self.R = linear_model(A, H, Q, R, transition="A")
+        n, m = self.H.shape[1], self.H.shape[0]
         self.P0: FloatArray = covariance("P0", P0, n, batch=True)
         alpha = _orders(order, n)
         self.order: FloatArray = np.broadcast_to(alpha, (n,)).copy()

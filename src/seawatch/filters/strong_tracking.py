@@ -42,7 +42,7 @@ from seawatch._validation import (
     covariance,
     finite,
     in_range,
-    matrix,
+    linear_model,
 )
 from seawatch.filters import _kalman_kernels as _kk
 from seawatch.filters.kalman import PARALLEL_MIN_TRACKS, raise_kernel_status
@@ -403,18 +403,8 @@ class StrongTrackingKalmanFilter:
         lambda_max: float = 100.0,
         late_fading: bool = False,
     ) -> None:
-        F = matrix("F", F)
-        n = F.shape[0]
-        if F.shape != (n, n) or n == 0:
-            raise ValueError(f"F: expected a square (n, n) matrix, got {F.shape}")
-        H = matrix("H", H, (None, n))
-        m = H.shape[0]
-        if m == 0:
-            raise ValueError("H: expected at least one measurement row, got shape (0, n)")
-        self.F: FloatArray = np.ascontiguousarray(F)
-        self.H: FloatArray = np.ascontiguousarray(H)
-        self.Q: FloatArray = np.ascontiguousarray(covariance("Q", Q, n))
-        self.R: FloatArray = np.ascontiguousarray(covariance("R", R, m, positive_definite=True))
+        self.F, self.H, self.Q, self.R = linear_model(F, H, Q, R)
+        n, m = self.H.shape[1], self.H.shape[0]
         x0a = finite("x0", as_float_array("x0", x0))
         if x0a.ndim < 1 or x0a.shape[-1] != n:
             raise ValueError(f"x0: expected shape (..., {n}), got {x0a.shape}")
