@@ -24,7 +24,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, Ti
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 
-err = Console(stderr=True)
+err = Console(stderr=True, soft_wrap=True)  # never break a path or message across lines
 
 
 class BadInput(ValueError):

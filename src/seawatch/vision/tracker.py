@@ -169,6 +169,9 @@ class VisualTracker:
         self._offsets: dict[int, FloatArray] = {}
         self._frame = 0
         self._horizon: Any = None
+        self.last_horizon: Any = None
+        """The horizon (:class:`~seawatch.vision.horizon.HorizonEstimate`) of the last
+        frame given to :meth:`detect`, or None (horizon off or no frame yet)."""
         if self.use_horizon:
             from seawatch.vision.horizon import HorizonTracker
 
@@ -183,6 +186,7 @@ class VisualTracker:
         hz = None
         if self._horizon is not None:
             hz = self._horizon.update(image, time)
+        self.last_horizon = hz
         try:
             det = self.detector(image, horizon=hz)
         except TypeError:
