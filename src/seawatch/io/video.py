@@ -765,6 +765,10 @@ class VideoWriter:
         preset: libx264 speed preset (``"ultrafast"`` … ``"veryslow"``).
         gop: keyframe interval in frames (None = encoder default).
         options: further encoder options (FFmpeg private options, strings).
+        container_options: muxer options (strings) that replace the defaults, e.g.
+            ``{"movflags": "+frag_keyframe+empty_moov+default_base_moof",
+            "frag_duration": "250000", "flush_packets": "1"}`` for a fragmented MP4
+            that stays playable up to the last fragment when the writer is killed.
     """
 
     def __init__(
@@ -777,6 +781,7 @@ class VideoWriter:
         preset: str = "veryfast",
         gop: int | None = None,
         options: dict[str, str] | None = None,
+        container_options: dict[str, str] | None = None,
     ) -> None:
         if not (isinstance(fps, int | float) and math.isfinite(fps) and fps > 0):
             raise ValueError(f"fps: expected a frame rate > 0 per second, got {fps!r}")
@@ -795,6 +800,7 @@ class VideoWriter:
         self.preset = preset
         self.gop = gop
         self.options = dict(options or {})
+        self.container_options = dict(container_options or {})
         self.frames_written = 0
         self._container: Any = None
         self._stream: Any = None
@@ -816,6 +822,7 @@ class VideoWriter:
         fmt_opts = {}
         if self.path.suffix.lower() in (".mp4", ".mov", ".m4v"):
             fmt_opts["movflags"] = "+faststart"
+        fmt_opts.update(self.container_options)
         try:
             container = av.open(str(self.path), "w", options=fmt_opts)
         except (av.error.FFmpegError, OSError, ValueError) as exc:

@@ -38,6 +38,19 @@ __all__ = ["AnnotatedVideo", "Annotator", "HorizonLike", "format_range", "track_
 FRAGMENT_S = 0.25
 """Longest duration of one MP4 fragment [s] (what a crash can lose, plus encoder delay)."""
 
+FRAGMENTED_MP4 = {
+    "movflags": "+frag_keyframe+empty_moov+default_base_moof",
+    "frag_duration": str(round(FRAGMENT_S * 1e6)),
+    "flush_packets": "1",
+}
+"""Muxer options of ``annotated.mp4``: fragments of at most :data:`FRAGMENT_S`, each packet
+flushed to the file as it is muxed."""
+
+
+def _is_mp4(path: str | os.PathLike[str]) -> bool:
+    return Path(path).suffix.lower() in (".mp4", ".mov", ".m4v")
+
+
 _GOLDEN = 0.6180339887498949
 _FONT = cv2.FONT_HERSHEY_SIMPLEX
 _HORIZON_BGR = (255, 255, 0)  # cyan
@@ -289,7 +302,13 @@ class AnnotatedVideo:
             raise ValueError(f"size: expected (width, height) integers >= 2 [px], got {size!r}")
         self.size = (w, h)
         self.annotator = annotator if annotator is not None else Annotator()
-        self._writer = _FragmentedWriter(path, fps, crf=crf, preset=preset)
+        self._writer = VideoWriter(
+            path,
+            fps,
+            crf=crf,
+            preset=preset,
+            container_options=FRAGMENTED_MP4 if _is_mp4(path) else None,
+        )
         self.path = self._writer.path
         self.fps = self._writer.fps
 
@@ -326,23 +345,3 @@ class AnnotatedVideo:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
-
-
-class _FragmentedWriter(VideoWriter):
-    """A :class:`VideoWriter` whose MP4 is fragmented and flushed packet by packet.
-
-    Sets the muxer options after the writer has opened its container and before the
-    first packet is muxed (the header is written then). TODO(lead): replace by a public
-    ``container_options`` argument of :class:`VideoWriter`.
-    """
-
-    def _open(self, image: NDArray[Any]) -> None:
-        super()._open(image)
-        if Path(self.path).suffix.lower() in (".mp4", ".mov", ".m4v"):
-            self._container.container_options.update(
-                {
-                    "movflags": "+frag_keyframe+empty_moov+default_base_moof",
-                    "frag_duration": str(round(FRAGMENT_S * 1e6)),
-                    "flush_packets": "1",
-                }
-            )
