@@ -1,59 +1,123 @@
-"""The main job, first stage: video in, tracked ships and their point-wise positions out.
+"""The main job: a camera video in, geo-referenced ship tracks out (issue 7).
 
-Wires the image stage to the geometry, nothing more (STYLE.md: the pipeline only wires):
-frames (:class:`seawatch.io.video.VideoReader`) → horizon + ship detector + visual
-tracker (:class:`seawatch.vision.tracker.VisualTracker`) → water-line pixel of each
-track → with a camera, (azimuth, depression) through
-:meth:`seawatch.camera.PinholeCamera.pixel_to_angles` and the point-wise curved-sea
-position of seed 000 eqs. 3–5 / ALGORITHMS.md §4.2
-(:func:`seawatch.geometry.sea_position`) with its 1-σ covariance for the camera's pixel
-noise. Rows go to ``tracks.csv`` (INTERFACES.md columns) frame by frame, flushed, so an
-interruption loses at most the frame in progress.
+This module only wires the stages (STYLE.md); each stage is its own module:
 
-Not yet here (issue 7): the world-frame filters (EKF/UKF on the angles, diffuse-RLS
-smoothing and forecasts) that give speed and course, the platform NAV input, AIS
-association and the report; their columns are written empty.
+1. frames — :class:`seawatch.io.video.VideoReader` (file, image folder, stream, device);
+2. image stage — :class:`seawatch.vision.tracker.VisualTracker`: horizon, ship boxes,
+   visual tracks with their water-line pixel (seed 001, ALGORITHMS.md §1);
+3. camera pose per frame — the camera file's intrinsics, height and attitude; on a
+   moving platform the NAV pose (:mod:`seawatch.io.nav`) gives position and heading; the
+   detected horizon refines pitch and roll (:func:`seawatch.camera.attitude_from_horizon`,
+   §4.3; ``attitude="horizon"``, the default) when it is found with confidence and lies
+   within :data:`HORIZON_TOLERANCE` of the file's attitude;
+4. angles — water-line pixel → azimuth (clockwise from North) and depression (below the
+   true horizontal) with their covariance for the pixel noise
+   (:meth:`seawatch.camera.PinholeCamera.pixel_to_angles`, ``angle_covariance``);
+5. world estimation — :class:`seawatch.tracking.world.WorldTracker`: point-wise
+   curved-sea geometry (seed 000 alg. 1), diffuse-RLS AR smoothing with forecasts
+   (alg. 2), and world-frame CV EKF/UKF on the angles with the platform's position
+   noise — position, speed, course, their uncertainty and +10 s / +30 s forecasts;
+6. AIS cross-check — :class:`seawatch.tracking.ais_match.AisAssociator` (MMSI labels,
+   "dark" tracks, AIS vessels in view but unseen);
+7. outputs, written as they are produced — ``tracks.csv`` (INTERFACES.md "Track table",
+   the ``best`` estimator, one row per track per frame, flushed once per frame in a
+   single write so that a kill loses at most the frame in progress), ``estimates.csv``
+   (every estimator, long form), ``tracks.geojson`` (rewritten about once per second of
+   video), ``annotated.mp4`` (fragmented MP4), and at the end ``report.html`` and, with a
+   truth file, the errors of :func:`seawatch.metrics.track_errors.score_tracks`.
+
+Times: video time [s] from the first frame; ``start`` [s since 1970-01-01 UTC] is the
+absolute time of frame 0, needed to align NAV and AIS (``seawatch synth ais`` writes it
+to ``clip.json`` beside the video, which is read when no ``start`` is given).
 """
 
 from __future__ import annotations
 
-import csv
+import json
 import math
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
+from seawatch.camera.horizon import attitude_from_horizon
 from seawatch.camera.pinhole import PinholeCamera
 from seawatch.geometry.geodesy import north_east_to_geodetic
-from seawatch.geometry.sea import range_sigma, sea_position, sea_position_covariance
+from seawatch.io.track_table import TableWriter
 from seawatch.io.video import VideoReader
+from seawatch.tracking.world import ESTIMATORS, PlatformPose, WorldEstimates, WorldTracker
 from seawatch.vision.tracker import VisualTracker
+
+__all__ = [
+    "ESTIMATE_COLUMNS",
+    "FORECAST_HORIZONS",
+    "PIXEL_SIGMA",
+    "TRACK_TABLE_COLUMNS",
+    "TrackRun",
+    "read_clip_start",
+    "track_video",
+]
+
+FORECAST_HORIZONS: tuple[float, ...] = (10.0, 30.0)
+"""Forecast horizons [s] of the track table (issue 7: +10 s and +30 s)."""
+
+
+def _forecast_columns() -> tuple[str, ...]:
+    cols: list[str] = []
+    for tau in FORECAST_HORIZONS:
+        s = f"{tau:g}s"
+        cols += [f"forecast_north_m_{s}", f"forecast_east_m_{s}"]
+        cols += [f"forecast_lat_{s}", f"forecast_lon_{s}"]
+    return tuple(cols)
+
 
 TRACK_TABLE_COLUMNS: tuple[str, ...] = (
     "time", "frame", "track_id", "x", "y", "w", "h", "u_wl", "v_wl", "azimuth_deg",
     "depression_deg", "range_m", "east_m", "north_m", "lat", "lon", "speed_mps",
     "course_deg", "sigma_range_m", "sigma_east_m", "sigma_north_m", "mmsi",
+    "estimator", *_forecast_columns(),
 )  # fmt: skip
-"""Columns of ``tracks.csv`` (INTERFACES.md "Track table"), in this order."""
+"""Columns of ``tracks.csv``: INTERFACES.md "Track table" in its order, then the estimator
+that gave the position columns and the forecast positions at :data:`FORECAST_HORIZONS`."""
+
+ESTIMATE_COLUMNS: tuple[str, ...] = (
+    "time", "frame", "track_id", "estimator", "north_m", "east_m", "lat", "lon",
+    "range_m", "sigma_range_m", "sigma_north_m", "sigma_east_m", "speed_mps",
+    "course_deg", "nis", *_forecast_columns(),
+)  # fmt: skip
+"""Columns of ``estimates.csv``: every estimator's output, one row per track, frame and
+estimator (long form)."""
 
 PIXEL_SIGMA = 1.0
 """Default 1-σ of the water-line pixel [px] (detector jitter plus quantisation)."""
 
+AIS_RATE = 5.0
+"""Rate of the AIS association updates [1/s] (every frame at most)."""
+
+AttitudeMode = Literal["horizon", "file"]
+HORIZON_CONFIDENCE = 0.5
+"""Least horizon confidence for an attitude refinement [-]."""
+HORIZON_TOLERANCE = math.radians(3.0)
+"""Largest pitch or roll change [rad] the horizon may make to the camera file's attitude
+(a "horizon" farther off is a coastline or a wake, not the sea horizon)."""
+
 
 @dataclass(frozen=True)
 class TrackRun:
-    """What :func:`track_video` produced.
+    """What :func:`track_video` produced (the ``--json`` summary of ``seawatch track``).
 
     Attributes:
         frames: frames processed.
         rows: rows written to ``tracks.csv``.
         tracks: distinct track ids seen.
         outputs: files written.
-        warnings: warning messages (e.g. no camera: pixel tracks only).
+        warnings: warning messages (no camera, NAV not covering the video, …).
+        errors: with a truth file, the INTERFACES.md ``errors`` object (and details).
+        ais: with AIS, the cross-check (matches, dark, unseen), else None.
+        interrupted: the run stopped early (Ctrl-C, a signal, a stream that ended).
     """
 
     frames: int
@@ -61,123 +125,459 @@ class TrackRun:
     tracks: int
     outputs: list[Path] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    errors: dict[str, Any] | None = None
+    ais: dict[str, Any] | None = None
+    interrupted: bool = False
 
     def to_json(self) -> dict[str, Any]:
         """The ``--json`` summary of ``seawatch track``."""
-        return {
+        doc: dict[str, Any] = {
             "frames": self.frames,
             "rows": self.rows,
             "tracks": self.tracks,
             "outputs": [str(p) for p in self.outputs],
             "warnings": list(self.warnings),
         }
+        if self.errors is not None:
+            doc["errors"] = self.errors
+        if self.ais is not None:
+            doc["ais"] = self.ais
+        if self.interrupted:
+            doc["interrupted"] = True
+        return doc
 
 
-def _cell(value: float | None) -> str:
-    return "" if value is None or not math.isfinite(value) else f"{value:.6g}"
+def read_clip_start(source: str | Path) -> float | None:
+    """Absolute time of frame 0 [s since the epoch] from ``clip.json`` beside ``source``.
 
-
-def geo_reference(
-    camera: PinholeCamera, uv: np.ndarray, sigma_px: float = PIXEL_SIGMA
-) -> dict[str, np.ndarray]:
-    """Angles, range and position of water-line pixels ``uv`` (k, 2) seen by ``camera``.
-
-    Azimuth is clockwise from North, depression below the true horizontal (= −elevation),
-    range the curved-sea arc distance with standard refraction (§4.2); rows at or above
-    the horizon get range +inf and NaN position (never an exception). σ's propagate the
-    isotropic pixel noise ``sigma_px`` through the camera Jacobian (§4.3) and the
-    geometry (§4.2, §7a). Units: degrees at this edge for the angles, metres otherwise.
+    ``seawatch synth ais`` writes ``clip.json`` with ``start_epoch``; None when there is
+    no such file (or it has no start).
     """
-    if camera.height is None:
-        raise ValueError("camera: the camera file gives no height above the sea (height_m)")
+    p = Path(source)
+    sidecar = (p if p.is_dir() else p.parent) / "clip.json"
+    if not sidecar.is_file():
+        return None
+    try:
+        value = json.loads(sidecar.read_text(encoding="utf-8")).get("start_epoch")
+    except (OSError, ValueError, AttributeError):
+        return None
+    return float(value) if isinstance(value, int | float) and math.isfinite(value) else None
+
+
+# ------------------------------------------------------------------------------ per frame
+class _Pose:
+    """The camera of each frame: file attitude, NAV pose, horizon refinement (step 3)."""
+
+    def __init__(
+        self,
+        camera: PinholeCamera,
+        platform: Any,
+        start: float | None,
+        attitude: AttitudeMode,
+        notes: list[str],
+    ) -> None:
+        self.camera = camera
+        self.platform = platform
+        self.start = start
+        self.use_horizon = attitude == "horizon"
+        self.notes = notes
+        self._nav_warned = False
+        self.lat0, self.lon0 = camera.lat, camera.lon
+        if platform is not None:
+            self.lat0, self.lon0 = platform.lat0, platform.lon0
+
+    def at(self, time: float, horizon: Any) -> tuple[PinholeCamera | None, PlatformPose | None]:
+        """(camera with its world attitude, platform pose) at video time ``time`` [s];
+        (None, None) where the NAV does not cover the time (positions unknown)."""
+        cam = self.camera
+        pose = None
+        if self.platform is not None:
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                nav = self.platform.pose_at(np.array([time + (self.start or 0.0)]))
+            if caught and not self._nav_warned:
+                self._nav_warned = True
+                self.notes.append(f"--platform: {caught[0].message}")
+            if not bool(nav.valid[0]):
+                return None, None
+            pitch = cam.pitch + (0.0 if np.isnan(nav.pitch[0]) else float(nav.pitch[0]))
+            roll = cam.roll + (0.0 if np.isnan(nav.roll[0]) else float(nav.roll[0]))
+            cam = cam.with_attitude(
+                heading=(cam.heading + float(nav.heading[0])) % (2 * math.pi),
+                pitch=pitch,
+                roll=roll,
+            )
+            h = float(nav.height[0])
+            pose = PlatformPose(
+                north=float(nav.north[0]),
+                east=float(nav.east[0]),
+                height=h if math.isfinite(h) and h > 0 else None,
+                sigma_position=float(getattr(self.platform, "sigma_position", 0.0) or 0.0),
+                velocity_north=float(nav.velocity[0, 0]),
+                velocity_east=float(nav.velocity[0, 1]),
+            )
+        if self.use_horizon and horizon is not None and getattr(horizon, "found", False):
+            if float(getattr(horizon, "confidence", 0.0)) >= HORIZON_CONFIDENCE:
+                line = np.array([[horizon.x0, horizon.y0], [horizon.x1, horizon.y1]])
+                att = attitude_from_horizon(cam, line, height=cam.height)
+                dp, dr = float(att.pitch) - cam.pitch, float(att.roll) - cam.roll
+                if abs(dp) <= HORIZON_TOLERANCE and abs(dr) <= HORIZON_TOLERANCE:
+                    cam = cam.with_attitude(pitch=float(att.pitch), roll=float(att.roll))
+        return cam, pose
+
+
+BOX_COLUMNS = ("x", "y", "w", "h", "u_wl", "v_wl")
+
+VIEW_SHIP_LENGTH = 20.0
+"""Length [m] of the smallest vessel that "should be in view" (AIS cross-check)."""
+VIEW_MIN_PIXELS = 5.0
+"""Its least length in the image [px] to count as visible."""
+VIEW_SHIP_TOP = 10.0
+"""Its height above the sea [m], for the distance at which it sinks below the horizon."""
+
+
+def _view_wedge(camera: PinholeCamera, platform: PlatformPose | None) -> Any:
+    """Where an AIS vessel "should be in view": inside the horizontal field of view, no
+    farther than a 20 m vessel is 5 px long, and not hidden by the earth's curvature
+    (camera horizon distance plus that of a 10 m superstructure, §4.2)."""
+    from seawatch.geometry.sea import horizon_distance
+    from seawatch.tracking.ais_match import ViewWedge
+
+    hfov = 2.0 * math.atan(0.5 * camera.image_size[0] / camera.fx)
+    h = camera.height if platform is None or platform.height is None else platform.height
+    seen = VIEW_SHIP_LENGTH * camera.fx / VIEW_MIN_PIXELS
+    hidden = float(horizon_distance(h) + horizon_distance(VIEW_SHIP_TOP))
+    return ViewWedge(
+        heading=camera.heading,
+        hfov=hfov,
+        max_range=min(seen, hidden),
+        north=0.0 if platform is None else platform.north,
+        east=0.0 if platform is None else platform.east,
+    )
+
+
+def _angles(
+    camera: PinholeCamera, uv: np.ndarray, sigma_px: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Azimuth, depression [rad] (k,) and their covariance (k, 2, 2) [rad²] of pixels."""
     az, el = camera.pixel_to_angles(uv, frame="world")
-    dep = -np.asarray(el)
-    cov = camera.angle_covariance(uv, sigma_px)
-    s_az = np.sqrt(cov[..., 0, 0])
-    s_dep = np.sqrt(cov[..., 1, 1])
-    pos = sea_position(camera.position, 0.0, az, dep, camera.height, curved=True)
-    with np.errstate(invalid="ignore"):
-        s_rng = range_sigma(dep, camera.height, s_dep, curved=True)
-        pcov = sea_position_covariance(0.0, az, dep, camera.height, s_az, s_dep, curved=True)
-    out = {
-        "azimuth_deg": np.degrees(az),
-        "depression_deg": np.degrees(dep),
-        "range_m": np.asarray(pos.range, dtype=float),
-        "north_m": pos.xy[..., 0],
-        "east_m": pos.xy[..., 1],
-        "sigma_range_m": np.asarray(s_rng, dtype=float),
-        "sigma_north_m": np.sqrt(pcov[..., 0, 0]),
-        "sigma_east_m": np.sqrt(pcov[..., 1, 1]),
+    cov = np.array(camera.angle_covariance(uv, sigma_px), dtype=float)
+    cov[..., 0, 1] = -cov[..., 0, 1]  # (azimuth, elevation) → (azimuth, depression)
+    cov[..., 1, 0] = -cov[..., 1, 0]
+    return np.asarray(az, float) % (2 * math.pi), -np.asarray(el, float), cov
+
+
+def _geodetic(north: np.ndarray, east: np.ndarray, lat0: Any, lon0: Any) -> tuple[Any, Any]:
+    if lat0 is None or lon0 is None:
+        return None, None
+    ok = np.isfinite(north) & np.isfinite(east)
+    lat = np.full(north.shape, np.nan)
+    lon = np.full(north.shape, np.nan)
+    if np.any(ok):
+        la, lo = north_east_to_geodetic(np.stack([north[ok], east[ok]], -1), lat0, lon0)
+        lat[ok], lon[ok] = la, lo
+    return lat, lon
+
+
+def _estimate_cells(est: WorldEstimates, k: int, lat0: Any, lon0: Any) -> dict[str, Any]:
+    """The position, motion and forecast cells of track ``k`` of one estimator."""
+    n, e = float(est.north[k]), float(est.east[k])
+    cov = est.covariance[k]
+    cells: dict[str, Any] = {
+        "north_m": n,
+        "east_m": e,
+        "range_m": float(est.range[k]),
+        "sigma_range_m": float(est.sigma_range[k]),
+        "sigma_north_m": math.sqrt(cov[0, 0]) if cov[0, 0] >= 0 else math.nan,
+        "sigma_east_m": math.sqrt(cov[1, 1]) if cov[1, 1] >= 0 else math.nan,
+        "speed_mps": float(est.speed[k]),
+        "course_deg": math.degrees(float(est.course[k])),
+        "nis": None if est.nis is None else float(est.nis[k]),
     }
-    if camera.lat is not None and camera.lon is not None:
-        lat, lon = north_east_to_geodetic(pos.xy, camera.lat, camera.lon)
-        out["lat"], out["lon"] = np.asarray(lat), np.asarray(lon)
-    return out
+    lat, lon = _geodetic(np.array([n]), np.array([e]), lat0, lon0)
+    if lat is not None:
+        cells["lat"], cells["lon"] = float(lat[0]), float(lon[0])
+    for tau in FORECAST_HORIZONS:
+        s = f"{tau:g}s"
+        f = est.forecasts.get(tau)
+        if f is None:
+            continue
+        fn, fe = float(f[k, 0]), float(f[k, 1])
+        cells[f"forecast_north_m_{s}"], cells[f"forecast_east_m_{s}"] = fn, fe
+        lat, lon = _geodetic(np.array([fn]), np.array([fe]), lat0, lon0)
+        if lat is not None:
+            cells[f"forecast_lat_{s}"], cells[f"forecast_lon_{s}"] = float(lat[0]), float(lon[0])
+    return cells
+
+
+# ------------------------------------------------------------------------------ the job
+def _prepare_out(out_dir: Path) -> Path:
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        probe = out_dir / ".seawatch-write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        raise ValueError(f"--out {out_dir}: cannot write ({exc.strerror or exc})") from None
+    return out_dir
 
 
 def track_video(
     source: str | Path,
-    out_dir: Path,
+    out_dir: str | Path,
     *,
     camera: PinholeCamera | None = None,
+    platform: Any = None,
+    ais: Any = None,
+    truth: str | Path | None = None,
+    start: float | None = None,
     filter: str = "afkf",
+    estimator: str = "ekf",
+    attitude: AttitudeMode = "horizon",
     step: int = 1,
     max_frames: int | None = None,
     sigma_px: float = PIXEL_SIGMA,
+    annotate: bool = True,
+    report: bool = True,
+    parquet: bool = False,
+    detector: Any = None,
     progress: Callable[[int, int | None], None] | None = None,
 ) -> TrackRun:
-    """Track the ships of a video, stream or image folder into ``out_dir/tracks.csv``.
+    """Track the ships of a video, stream or image folder into ``out_dir`` (module docstring).
 
     Args:
         source: video file, URL, device or image folder (:class:`VideoReader`).
         out_dir: output folder (created; an unwritable one fails before any work).
         camera: the calibrated, mounted camera; None gives pixel tracks only (angle,
             range and position columns empty, with a warning).
+        platform: a :class:`seawatch.io.nav.NavTrack` for a camera on a moving
+            platform (its heading adds to the camera's mounting heading), else None.
+        ais: a :class:`seawatch.io.ais.AisTable` to cross-check the tracks with.
+        truth: ``truth.csv`` of ``seawatch synth`` to score the run against.
+        start: absolute time of frame 0 [s since the epoch] (NAV/AIS alignment); None:
+            from ``clip.json`` beside the source, else the NAV's first time.
         filter: the visual tracker's filter, ``afkf`` (default), ``fkf`` or ``kf``.
+        estimator: the world estimator of the ``tracks.csv`` positions (``ekf``
+            default; ``ukf``, ``diffuse-rls``, ``geometry``); all go to ``estimates.csv``.
+        attitude: ``horizon`` (default: pitch and roll refined by the detected horizon
+            each frame — a mast sways by tenths of a degree, several per cent of range
+            at 1 km) or ``file`` (the camera file's attitude plus the NAV's pitch/roll:
+            for a view where land, not sea, meets the sky).
         step, max_frames: frame decimation and limit.
-        sigma_px: 1-σ of the water-line pixel [px] for the position uncertainty.
+        sigma_px: 1-σ of the water-line pixel [px].
+        annotate, report, parquet: write ``annotated.mp4``, ``report.html``,
+            ``tracks.parquet``.
+        detector: the ship detector (default: the classical detector).
         progress: ``progress(frames_done, frames_total_or_None)``.
+
+    Returns:
+        :class:`TrackRun`. Ctrl-C (KeyboardInterrupt) ends the run early with every
+        output closed and the report written for the frames done (``interrupted``).
+
+    Raises:
+        ValueError: bad input, naming it (also raised by the readers:
+            :class:`seawatch.io.video.VideoError` for a missing or undecodable video).
     """
-    out_dir = Path(out_dir)
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-        path = out_dir / "tracks.csv"
-        sink = path.open("w", newline="", encoding="utf-8")
-    except OSError as exc:
-        raise ValueError(f"--out {out_dir}: cannot write ({exc.strerror})") from None
+    if estimator not in ESTIMATORS:
+        raise ValueError(f"--estimator: expected one of {', '.join(ESTIMATORS)}, got {estimator!r}")
+    if attitude not in ("horizon", "file"):
+        raise ValueError(f"--attitude: expected horizon or file, got {attitude!r}")
+    out = _prepare_out(Path(out_dir))
     notes: list[str] = []
+
+    def note(text: str) -> None:
+        notes.append(text)
+        warnings.warn(text, stacklevel=3)
+
     if camera is None:
-        notes.append("no --camera: pixel tracks only (angle, range and position columns are empty)")
-        warnings.warn(notes[-1], stacklevel=2)
+        note("no --camera: pixel tracks only (angle, range and position columns are empty)")
+        if platform is not None or ais is not None:
+            note("no --camera: --platform and --ais are ignored")
+            platform = ais = None
+    elif camera.height is None:
+        raise ValueError("--camera: the camera file gives no height above the sea (height_m)")
+    elif platform is None and (camera.lat is None or camera.lon is None):
+        if ais is not None:
+            raise ValueError(
+                "--camera: the camera file has no lat/lon and there is no --platform NAV: "
+                "AIS positions cannot be placed relative to the camera"
+            )
+    if start is None:
+        start = read_clip_start(source)
+    if start is None and platform is not None:
+        start = float(platform.span[0])
+        note(f"--platform: no --start; video time 0 taken as the NAV's first time {start:.3f} s")
+    if ais is not None and start is None:
+        note("--ais: no --start and no clip.json beside the video: AIS cross-check skipped")
+        ais = None
+
     reader = VideoReader(source, step=step, max_frames=max_frames)
-    tracker = VisualTracker(filter=filter, fps=reader.fps or 25.0)
+    fps = reader.fps or 25.0
+    vtracker = VisualTracker(detector=detector, filter=filter, fps=fps)
+    pose = _Pose(camera, platform, start, attitude, notes) if camera is not None else None
+    world = None
+    if camera is not None:
+        ifov = 1.0 / camera.fx
+        world = WorldTracker(
+            camera.height,
+            sigma_angle=sigma_px * ifov,
+            horizons=FORECAST_HORIZONS,
+            best=estimator,
+            frame_interval=step / fps,
+        )
+    lat0 = pose.lat0 if pose is not None else None
+    lon0 = pose.lon0 if pose is not None else None
+
+    tracks_out = TableWriter(out / "tracks.csv", TRACK_TABLE_COLUMNS, parquet=parquet)
+    est_out = TableWriter(out / "estimates.csv", ESTIMATE_COLUMNS) if world is not None else None
+    geo_sink = None
+    if lat0 is not None and lon0 is not None:
+        from seawatch.report.geojson import GeoJsonSink
+
+        geo_sink = GeoJsonSink(
+            out / "tracks.geojson", camera_lat=lat0, camera_lon=lon0, epoch=start
+        )
+    associator = None
+    ais_every = 1
+    if ais is not None and lat0 is not None:
+        from seawatch.tracking.ais_match import AisAssociator
+
+        associator = AisAssociator(ais, lat0=lat0, lon0=lon0)
+        ais_every = max(1, round(fps / step / AIS_RATE))
+    video_out = None
     total = reader.frame_count
-    frames = rows = 0
+    frames = 0
     ids: set[int] = set()
-    with sink:
-        writer = csv.writer(sink)
-        writer.writerow(TRACK_TABLE_COLUMNS)
+    labels: dict[int, int | None] = {}
+    live_ids: set[int] = set()
+    interrupted = False
+    try:
         for frame in reader:
-            tracks = tracker.step(frame.image, frame.time)
-            geo = geo_reference(camera, tracks[:, 5:7], sigma_px) if camera and len(tracks) else {}
-            for k, row in enumerate(tracks):
-                values = {
-                    "time": frame.time,
-                    "frame": frame.index,
-                    "track_id": int(row[0]),
-                    **dict(zip(("x", "y", "w", "h", "u_wl", "v_wl"), row[1:7], strict=True)),
-                    **{name: float(col[k]) for name, col in geo.items()},
+            rows = vtracker.step(frame.image, frame.time)
+            horizon = vtracker.last_horizon
+            t = float(frame.time)
+            k = rows.shape[0]
+            tids = rows[:, 0].astype(np.int64)
+            records: list[dict[str, Any]] = [
+                {
+                    "time": t,
+                    "frame": int(frame.index),
+                    "track_id": int(tids[i]),
+                    **dict(
+                        zip(
+                            BOX_COLUMNS,
+                            map(float, rows[i, 1:7]),
+                            strict=True,
+                        )
+                    ),
                 }
-                writer.writerow(
-                    [
-                        str(values[c]) if c in ("frame", "track_id") else _cell(values.get(c))
-                        for c in TRACK_TABLE_COLUMNS
-                    ]
-                )
-                ids.add(int(row[0]))
-                rows += 1
-            sink.flush()
+                for i in range(k)
+            ]
+            if world is not None and pose is not None:
+                gone = live_ids - set(tids.tolist())
+                if gone:
+                    world.drop(np.fromiter(gone, np.int64))
+                live_ids = set(tids.tolist())
+                cam, ppose = pose.at(t, horizon)
+                if cam is not None and k:
+                    az, dep, cov = _angles(cam, rows[:, 5:7], sigma_px)
+                    estimates = world.update(t, tids, az, dep, angle_covariance=cov, platform=ppose)
+                    best = estimates[estimator]
+                    for i, rec in enumerate(records):
+                        rec["azimuth_deg"] = math.degrees(float(az[i]))
+                        rec["depression_deg"] = math.degrees(float(dep[i]))
+                        rec["estimator"] = estimator
+                        rec.update(_estimate_cells(best, i, lat0, lon0))
+                    for name, est in estimates.items():
+                        for i, rec in enumerate(records):
+                            est_out.write(  # type: ignore[union-attr]
+                                {**rec, "estimator": name, **_estimate_cells(est, i, lat0, lon0)}
+                            )
+                    if associator is not None and frames % ais_every == 0:
+                        view = _view_wedge(cam, ppose)
+                        vel = np.stack(
+                            [best.speed * np.cos(best.course), best.speed * np.sin(best.course)], -1
+                        )
+                        labels.update(
+                            associator.update(
+                                start + t, tids, best.north, best.east, best.covariance, vel, view
+                            )
+                        )
+                    for rec in records:
+                        mmsi = labels.get(rec["track_id"])
+                        rec["mmsi"] = mmsi
+                elif k:
+                    for rec in records:
+                        rec["estimator"] = estimator
+            for rec in records:
+                tracks_out.write(rec)
+                ids.add(rec["track_id"])
+            tracks_out.flush()
+            if est_out is not None:
+                est_out.flush()
+            if geo_sink is not None:
+                geo_sink.add(records, t)
+            if annotate:
+                if video_out is None:
+                    from seawatch.report.annotate import AnnotatedVideo
+
+                    h, w = frame.image.shape[:2]
+                    video_out = AnnotatedVideo(out / "annotated.mp4", fps / step, (w, h))
+                video_out.write(frame.image, records, horizon, time=t, frame=int(frame.index))
             frames += 1
             if progress is not None:
                 progress(frames, total)
-    return TrackRun(frames=frames, rows=rows, tracks=len(ids), outputs=[path], warnings=notes)
+    except KeyboardInterrupt:
+        interrupted = True
+        note(f"interrupted after {frames} frames; outputs hold every frame done")
+    finally:
+        outputs = tracks_out.close()
+        if est_out is not None:
+            outputs += est_out.close()
+        if video_out is not None:
+            video_out.close()
+            outputs.append(out / "annotated.mp4")
+        if geo_sink is not None:
+            g = geo_sink.close()
+            if g is not None:
+                outputs.append(g)
+    ais_doc = associator.result().as_dict() if associator is not None else None
+    errors = None
+    if truth is not None:
+        from seawatch.metrics.track_errors import score_tracks
+
+        errors = score_tracks(out / "tracks.csv", truth, camera=camera).to_json()
+    run = TrackRun(
+        frames=frames,
+        rows=tracks_out.rows,
+        tracks=len(ids),
+        outputs=outputs,
+        warnings=notes,
+        errors=errors,
+        ais=ais_doc,
+        interrupted=interrupted,
+    )
+    if report:
+        from seawatch.report.html import write_report
+
+        summary = {**run.to_json(), "source": str(source), "fps": fps}
+        path = write_report(
+            out / "report.html", out / "tracks.csv", camera=camera, summary=summary,
+            errors=errors, ais=ais_doc,
+        )  # fmt: skip
+        run.outputs.append(path)
+    return run
+
+
+def error_summary(errors: Mapping[str, Any] | None) -> list[str]:
+    """Three lines summarising an ``errors`` object (``seawatch demo``)."""
+    if not errors:
+        return []
+    e = errors
+    return [
+        f"position RMSE {e.get('rmse_position_m', float('nan')):.1f} m, range error "
+        f"{e.get('rmse_range_percent', float('nan')):.2f} %",
+        f"MOTA {e.get('mota', float('nan')):.3f}, IDF1 {e.get('idf1', float('nan')):.3f}, "
+        f"{e.get('id_switches', 0)} identity switches",
+        f"box centre error {e.get('cle_px', float('nan')):.1f} px",
+    ]

@@ -1,64 +1,213 @@
-"""``seawatch track``: video in, tracked ships (and, with a camera, their positions) out."""
+"""``seawatch track``: a camera video in, geo-referenced ship tracks out (the main job)."""
 
 from __future__ import annotations
 
+import signal
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
-from seawatch.cli._common import emit_json, err, exit_codes, progress_bar, warnings_to_stderr
+from seawatch.cli._common import (
+    EXIT_FAILED,
+    BadInput,
+    emit_json,
+    err,
+    exit_codes,
+    progress_bar,
+    warnings_to_stderr,
+)
+
+
+@contextmanager
+def _terminate_as_interrupt() -> Iterator[None]:
+    """SIGTERM ends the run like Ctrl-C: outputs closed, report written for frames done."""
+
+    def handler(signum: int, frame: Any) -> None:
+        raise KeyboardInterrupt
+
+    try:
+        old = signal.signal(signal.SIGTERM, handler)
+    except ValueError:  # not the main thread (e.g. inside a test runner's thread)
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)
+
+
+def _load_inputs(
+    camera: Path | None,
+    platform: Path | None,
+    ais: Path | None,
+    truth: Path | None,
+    start: str | None,
+) -> dict[str, Any]:
+    """Read every input file before any work: bad input is exit 2 naming the option."""
+    from seawatch.io.camera_file import load_camera
+
+    out: dict[str, Any] = {"camera": None, "platform": None, "ais": None, "start": None}
+    if camera is not None:
+        try:
+            out["camera"] = load_camera(camera)
+        except FileNotFoundError:
+            raise BadInput(f"--camera {camera}: no such file") from None
+        except ValueError as exc:
+            raise BadInput(f"--camera: {exc}") from None
+    if platform is not None:
+        from seawatch.io.nav import read_nav
+
+        try:
+            out["platform"] = read_nav(platform)
+        except FileNotFoundError:
+            raise BadInput(f"--platform {platform}: no such file") from None
+        except ValueError as exc:
+            raise BadInput(f"--platform: {exc}") from None
+    if ais is not None:
+        from seawatch.io.ais import read_ais
+
+        try:
+            out["ais"] = read_ais(ais)
+        except FileNotFoundError:
+            raise BadInput(f"--ais {ais}: no such file") from None
+        except ValueError as exc:
+            raise BadInput(f"--ais: {exc}") from None
+        if len(out["ais"]) == 0:
+            raise BadInput(f"--ais {ais}: no position report could be decoded")
+    if truth is not None and not truth.is_file():
+        raise BadInput(f"--truth {truth}: no such file")
+    if start is not None:
+        from seawatch.io.nav import parse_time
+
+        try:
+            out["start"] = parse_time(start, "--start")
+        except ValueError as exc:
+            raise BadInput(str(exc)) from None
+    return out
 
 
 def track(
     source: Annotated[str, typer.Argument(help="Video file, stream URL, device or image folder.")],
     camera: Annotated[
         Path | None,
-        typer.Option(help="Camera file (seawatch or OpenCV YAML) with height and attitude."),
+        typer.Option(help="Camera file (seawatch or OpenCV YAML): intrinsics, height, attitude."),
+    ] = None,
+    platform: Annotated[
+        Path | None,
+        typer.Option(
+            help="NAV of a moving platform: CSV (time, lat/lon or x/y, heading[, pitch, roll, "
+            "height]) or NMEA (GGA/RMC/HDT/VTG)."
+        ),
+    ] = None,
+    ais: Annotated[
+        Path | None,
+        typer.Option(help="AIS to cross-check with: raw NMEA (!AIVDM) or decoded CSV."),
+    ] = None,
+    truth: Annotated[
+        Path | None, typer.Option(help="truth.csv of `seawatch synth`: score the run.")
+    ] = None,
+    start: Annotated[
+        str | None,
+        typer.Option(
+            help="UTC time of the first frame (ISO-8601 or epoch s) for NAV/AIS; default: "
+            "clip.json beside the video, else the NAV's first time."
+        ),
     ] = None,
     out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("out/track"),
+    estimator: Annotated[
+        str,
+        typer.Option(help="World estimator of tracks.csv: ekf, ukf, diffuse-rls or geometry."),
+    ] = "ekf",
+    attitude: Annotated[
+        str,
+        typer.Option(
+            help="horizon: pitch/roll refined by the detected horizon; file: the camera "
+            "file's (and NAV's) attitude only."
+        ),
+    ] = "horizon",
     filter: Annotated[str, typer.Option(help="Visual tracking filter: afkf, fkf or kf.")] = "afkf",
+    pixel_sigma: Annotated[
+        float, typer.Option(help="1-sigma of the water-line pixel [px].", min=0.01)
+    ] = 1.0,
     step: Annotated[int, typer.Option(help="Use every STEP-th frame.", min=1)] = 1,
     max_frames: Annotated[
         int | None, typer.Option(help="Stop after this many frames.", min=1)
     ] = None,
+    video: Annotated[bool, typer.Option(help="Write annotated.mp4.")] = True,
+    report: Annotated[bool, typer.Option(help="Write report.html.")] = True,
+    parquet: Annotated[bool, typer.Option(help="Also write tracks.parquet (pyarrow).")] = False,
     json_out: Annotated[
         bool, typer.Option("--json", help="Print a JSON summary on stdout.")
     ] = False,
 ) -> None:
-    """Track the ships of a video and write tracks.csv (INTERFACES.md columns) as it goes.
+    """Track the ships of a video and geo-reference them: tracks.csv, estimates.csv,
+    tracks.geojson, annotated.mp4 and report.html, written as they are produced.
 
-    Without [bold]--camera[/] the tracks are in pixels only (angle, range and position
-    columns empty, with a warning), so any clip can be tracked before it is calibrated.
-    With a camera, every track's water-line pixel becomes azimuth, depression, curved-sea
-    range, north/east (and lat/lon when the camera has a geodetic position) with 1-σ
-    errors — point-wise geometry; the world-frame filters that add speed and course
-    come with the next stage of the pipeline.
+    Per frame: horizon, ship boxes and visual tracks; with [bold]--camera[/], each track's
+    water-line pixel becomes azimuth and depression (attitude refined by the horizon),
+    then point-wise curved-sea geometry, diffuse-RLS AR smoothing with forecasts and a
+    world-frame EKF/UKF give position, speed, course, their 1-sigma and +10 s/+30 s
+    forecasts (tracks.csv holds --estimator's; estimates.csv all of them). Without a
+    camera the tracks are in pixels only (with a warning). [bold]--platform[/] places a
+    camera on a moving boat; [bold]--ais[/] labels tracks with MMSIs and lists "dark"
+    tracks and unseen AIS vessels; [bold]--truth[/] adds the errors to the summary.
+    Ctrl-C or SIGTERM stops cleanly: every frame done is in the outputs.
 
     Example: [cyan]seawatch synth ship-video --case medium --out clip && seawatch track
-    clip/video.mp4 --camera clip/camera.yaml --out out/track --json[/]
+    clip/video.mp4 --camera clip/camera.yaml --truth clip/truth.csv --out out/track --json[/]
     """
-    from seawatch.io.camera_file import load_camera
-    from seawatch.pipeline import track_video
+    from seawatch.pipeline import error_summary, track_video
 
     with exit_codes(), warnings_to_stderr():
         if filter not in ("afkf", "fkf", "kf"):
-            raise ValueError(f"--filter: expected afkf, fkf or kf, got {filter!r}")
-        cam = load_camera(camera) if camera is not None else None
-        with progress_bar() as bar:
+            raise BadInput(f"--filter: expected afkf, fkf or kf, got {filter!r}")
+        if estimator not in ("ekf", "ukf", "diffuse-rls", "geometry"):
+            raise BadInput(
+                f"--estimator: expected ekf, ukf, diffuse-rls or geometry, got {estimator!r}"
+            )
+        if attitude not in ("horizon", "file"):
+            raise BadInput(f"--attitude: expected horizon or file, got {attitude!r}")
+        inputs = _load_inputs(camera, platform, ais, truth, start)
+        live = "://" in source or source.isdigit() or source.startswith("/dev/")
+        with progress_bar() as bar, _terminate_as_interrupt():
             task = bar.add_task(f"track {Path(source).name or source}", total=None)
+
+            def progress(done: int, total: int | None) -> None:
+                if total is None and live:
+                    bar.update(task, completed=done, description=f"track {source}: {done} frames")
+                else:
+                    bar.update(task, completed=done, total=total)
+
             result = track_video(
                 source,
                 out,
-                camera=cam,
+                camera=inputs["camera"],
+                platform=inputs["platform"],
+                ais=inputs["ais"],
+                truth=truth,
+                start=inputs["start"],
                 filter=filter,
+                estimator=estimator,
+                attitude=attitude,  # type: ignore[arg-type]
+                sigma_px=pixel_sigma,
                 step=step,
                 max_frames=max_frames,
-                progress=lambda done, total: bar.update(task, completed=done, total=total),
+                annotate=video,
+                report=report,
+                parquet=parquet,
+                progress=progress,
             )
         if json_out:
             emit_json(result.to_json())
         else:
             err.print(f"{result.frames} frames, {result.tracks} tracks, {result.rows} rows")
+            for line in error_summary(result.errors):
+                err.print(line)
             for path in result.outputs:
                 typer.echo(f"wrote {path}")
+        if result.interrupted:
+            err.print("[bold red]interrupted:[/] the outputs hold every frame done")
+            raise typer.Exit(EXIT_FAILED)

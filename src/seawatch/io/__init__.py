@@ -1,4 +1,4 @@
-"""The edges of the system: files in and out (video, camera, AIS, MOT files).
+"""The edges of the system: files in and out (video, camera, AIS, NAV, MOT, track tables).
 
 Degrees, knots and other display units live here and are converted to SI units and
 radians on the way in (STYLE.md).
@@ -15,6 +15,8 @@ from seawatch.io.ais import (
 )
 from seawatch.io.camera_file import FORMAT_TAG, camera_to_dict, load_camera, save_camera
 from seawatch.io.mot import read_mot, write_mot
+from seawatch.io.nav import NavPoses, NavTrack, NavWarning, parse_time, read_nav
+from seawatch.io.track_table import TableWriter, read_table
 from seawatch.io.video import (
     Frame,
     VideoError,
@@ -29,6 +31,10 @@ __all__ = [
     "AisTable",
     "AisWarning",
     "Frame",
+    "NavPoses",
+    "NavTrack",
+    "NavWarning",
+    "TableWriter",
     "VideoError",
     "VideoReader",
     "VideoWarning",
@@ -36,11 +42,14 @@ __all__ = [
     "camera_to_dict",
     "interpolate_track",
     "load_camera",
+    "parse_time",
     "read_ais",
     "read_ais_csv",
     "read_ais_nmea",
     "read_image",
     "read_mot",
+    "read_nav",
+    "read_table",
     "save_camera",
     "tracks",
     "write_mot",
