@@ -1,0 +1,5 @@
+"""``python -m seawatch …`` — the same as the ``seawatch`` command."""
+
+from seawatch.cli import main
+
+main()
