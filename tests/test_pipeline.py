@@ -29,7 +29,9 @@ def _rows(path):
 
 
 def test_positions_agree_with_the_rendered_truth_within_their_sigma(clip, tmp_path):
-    run = track_video(clip / "video.mp4", tmp_path, camera=load_camera(clip / "camera.yaml"))
+    # the case's mast sways: the horizon gives each frame's pitch and roll
+    cam = load_camera(clip / "camera.yaml")
+    run = track_video(clip / "video.mp4", tmp_path, camera=cam, attitude="horizon")
     rows = _rows(tmp_path / "tracks.csv")
     assert run.rows == len(rows) > 20 and run.tracks == 1
     assert list(rows[0]) == list(TRACK_TABLE_COLUMNS)

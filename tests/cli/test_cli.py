@@ -11,6 +11,7 @@ from typer.testing import CliRunner
 
 from seawatch import __version__
 from seawatch.cli import app
+from seawatch.io.camera_file import load_camera
 
 runner = CliRunner()
 
@@ -57,16 +58,23 @@ def test_unknown_option_is_a_usage_error_exit_2():
     assert result.exit_code == 2
 
 
-def test_demo_json_lists_outputs_that_exist_and_records_of_every_filter(tmp_path):
-    result = runner.invoke(app, ["demo", "--out", str(tmp_path), "--runs", "3", "--json"])
+def test_demo_tracks_real_solent_traffic_and_reports_the_errors(tmp_path):
+    result = runner.invoke(app, ["demo", "--out", str(tmp_path), "--json"])
     assert result.exit_code == 0, result.output
     doc = json.loads(result.stdout)
-    assert doc["scenario"] == "air-range" and doc["runs"] == 3
+    names = {path.rsplit("/", 1)[-1] for path in doc["outputs"]}
+    want = {"tracks.csv", "estimates.csv", "tracks.geojson", "annotated.mp4", "report.html"}
+    assert want | {"camera.yaml"} <= names
     for path in doc["outputs"]:
         assert (tmp_path / path.rsplit("/", 1)[-1]).stat().st_size > 0
-    estimators = {r["estimator"] for r in doc["results"]}
-    assert {"raw", "ncv-1", "nca-0.1", "ancv", "anca"} <= estimators
-    assert all(r["unit"] == "m" and r["mean"] > 0 for r in doc["results"])
+    errors = doc["errors"]
+    keys = {"rmse_position_m", "rmse_range_percent", "cle_px", "id_switches", "mota", "idf1"}
+    assert keys <= set(errors) and errors["frames_scored"] > 100
+    # the AIS cross-check labels tracks with the MMSIs of the rendered vessels
+    clip = json.loads((tmp_path / "clip" / "clip.json").read_text())
+    assert doc["ais"]["matches"] and all(m["mmsi"] in clip["mmsi"] for m in doc["ais"]["matches"])
+    # the camera file written is the one the clip was rendered with
+    assert load_camera(tmp_path / "camera.yaml") == load_camera(tmp_path / "clip" / "camera.yaml")
 
 
 def test_experiment_json_has_the_interfaces_shape(tmp_path):

@@ -8,7 +8,7 @@ input. See INTERFACES.md for the contract.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 from rich.table import Table
@@ -23,7 +23,15 @@ from seawatch.cli import (
     tbd_cmds,
     track_cmds,
 )
-from seawatch.cli._common import EXIT_FAILED, BadInput, emit_json, err, exit_codes, progress_bar
+from seawatch.cli._common import (
+    EXIT_FAILED,
+    BadInput,
+    emit_json,
+    err,
+    exit_codes,
+    progress_bar,
+    warnings_to_stderr,
+)
 
 app = typer.Typer(
     name="seawatch",
@@ -56,55 +64,41 @@ def _root(
 @app.command()
 def demo(
     out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("out/demo"),
-    runs: Annotated[int, typer.Option(help="Monte-Carlo runs.", min=1)] = 50,
-    seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
     json_out: Annotated[
         bool, typer.Option("--json", help="Print a JSON summary on stdout.")
     ] = False,
 ) -> None:
-    """Run the bundled demo and print where its outputs are.
+    """Run the main job on the bundled default: real Solent ship traffic, seen by a camera.
 
-    Until the video pipeline lands, the demo is the [bold]air-range[/] scenario of seed 002:
-    an aircraft approaching from 5 km, its range measured from its image size and
-    filtered by NCV, NCA and the adaptive ANCV/ANCA filters. Writes the error table
-    (errors.csv) and a plot of range error against range (range_error.png).
+    A fixed shore camera on the Solent watches the real AIS traffic of the packaged file
+    (2016-01-12): [bold]seawatch synth ais[/] renders it into a 1080p clip with ground
+    truth (reused on later runs), then [bold]seawatch track[/] tracks it with the camera
+    file, the AIS file and the truth. Writes everything [bold]seawatch track[/] writes
+    (tracks.csv, estimates.csv, tracks.geojson, annotated.mp4, report.html) plus the
+    camera.yaml it used, and prints the report's path and a three-line error summary.
 
-    Example: [cyan]seawatch demo --out out/demo[/]
+    Example: [cyan]seawatch demo --out out/demo --json[/]
     """
-    from seawatch.scenarios import air_range
+    from seawatch.demo import run_demo
+    from seawatch.pipeline import error_summary
 
-    with exit_codes():
+    with exit_codes(), warnings_to_stderr():
         with progress_bar() as bar:
-            task = bar.add_task("air-range Monte Carlo", total=runs)
-            result = air_range.run_demo(
-                out,
-                runs=runs,
-                seed=seed,
-                progress=lambda done, total: bar.update(task, completed=done),
-            )
-        outputs = [str(result.table_path), str(result.plot_path)]
+            tasks: dict[str, Any] = {}
+
+            def progress(stage: str, done: int, total: int | None) -> None:
+                if stage not in tasks:
+                    tasks[stage] = bar.add_task(f"demo: {stage}", total=total)
+                bar.update(tasks[stage], completed=done, total=total)
+
+            result = run_demo(out, progress=progress)
         if json_out:
-            emit_json(
-                {
-                    "scenario": "air-range",
-                    "runs": runs,
-                    "seed": seed,
-                    "results": result.records,
-                    "outputs": outputs,
-                }
-            )
+            emit_json(result.to_json())
             return
-        metrics = air_range.METRICS
-        table = Table(title=f"air-range: RMS range error (m) over {runs} runs (seed {seed})")
-        table.add_column("filter")
-        for metric in metrics:
-            table.add_column(metric, justify="right")
-        for row in result.rows:
-            cells = (f"{row[f'{m}_m']:.2f} ± {row[f'{m}_stderr_m']:.2f}" for m in metrics)
-            table.add_row(row["estimator"], *cells)
-        err.print(table)
-        for path in outputs:
-            typer.echo(f"wrote {path}")
+        for line in error_summary(result.track.errors):
+            typer.echo(line)
+        typer.echo(f"report: {result.report}")
+        typer.echo(f"outputs in {out}/ (tracks.csv, tracks.geojson, annotated.mp4, camera.yaml)")
 
 
 @app.command()

@@ -124,10 +124,11 @@ def track(
     attitude: Annotated[
         str,
         typer.Option(
-            help="horizon: pitch/roll refined by the detected horizon; file: the camera "
-            "file's (and NAV's) attitude only."
+            help="horizon: pitch/roll refined by the detected horizon each frame (a swaying "
+            "mast); file: the camera file's (and NAV's) attitude; auto: horizon on a moving "
+            "platform, file for a fixed camera."
         ),
-    ] = "horizon",
+    ] = "auto",
     filter: Annotated[str, typer.Option(help="Visual tracking filter: afkf, fkf or kf.")] = "afkf",
     pixel_sigma: Annotated[
         float, typer.Option(help="1-sigma of the water-line pixel [px].", min=0.01)
@@ -168,8 +169,8 @@ def track(
             raise BadInput(
                 f"--estimator: expected ekf, ukf, diffuse-rls or geometry, got {estimator!r}"
             )
-        if attitude not in ("horizon", "file"):
-            raise BadInput(f"--attitude: expected horizon or file, got {attitude!r}")
+        if attitude not in ("auto", "horizon", "file"):
+            raise BadInput(f"--attitude: expected auto, horizon or file, got {attitude!r}")
         inputs = _load_inputs(camera, platform, ais, truth, start)
         live = "://" in source or source.isdigit() or source.startswith("/dev/")
         with progress_bar() as bar, _terminate_as_interrupt():

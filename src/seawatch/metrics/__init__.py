@@ -44,6 +44,7 @@ from seawatch.metrics.ospa import (
     ospa,
     ospa_series,
 )
+from seawatch.metrics.track_errors import TrackErrors, score_tracks
 
 __all__ = [
     "CLEResult",
@@ -54,6 +55,7 @@ __all__ = [
     "IdentityMetrics",
     "MOTMetrics",
     "PCRBResult",
+    "TrackErrors",
     "air_range_pcrb",
     "box_iou",
     "centre_location_error",
@@ -71,6 +73,7 @@ __all__ = [
     "pcrb_information",
     "pcrb_linear",
     "pcrb_nonlinear_measurement",
+    "score_tracks",
     "sea_surface_angles_pcrb",
     "uav_sea_pcrb",
 ]

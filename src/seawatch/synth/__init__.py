@@ -9,6 +9,16 @@
 - :mod:`seawatch.synth.cases` — the ``ship-video`` cases of SCENARIOS.md (seed 001).
 """
 
+from seawatch.synth.ais_scene import (
+    DEMO,
+    AisRenderResult,
+    AisScene,
+    DemoSettings,
+    ais_ships,
+    busiest_start,
+    demo_camera,
+    render_ais,
+)
 from seawatch.synth.cases import CASES, ShipVideoCase, render_case, ship_video_case
 from seawatch.synth.render import (
     HORIZON_COLUMNS,
@@ -41,10 +51,14 @@ from seawatch.synth.world import (
 
 __all__ = [
     "CASES",
+    "DEMO",
     "HORIZON_COLUMNS",
     "KINDS",
     "LIGHTINGS",
     "TRUTH_COLUMNS",
+    "AisRenderResult",
+    "AisScene",
+    "DemoSettings",
     "Lighting",
     "ObjectTruth",
     "Prism",
@@ -54,13 +68,17 @@ __all__ = [
     "Ship",
     "ShipVideoCase",
     "Trajectory",
+    "ais_ships",
+    "busiest_start",
     "crossing",
+    "demo_camera",
     "hull_prism",
     "lighting_preset",
     "make_ship",
     "meeting",
     "overtaking",
     "render",
+    "render_ais",
     "render_case",
     "ship_video_case",
     "ships_from_tracks",
