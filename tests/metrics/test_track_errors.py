@@ -293,3 +293,23 @@ def test_bad_files_raise_value_error_naming_the_file(tmp_path: Path, truth: Path
         score_tracks(tracks, truth, threshold=1.5)
     with pytest.raises(ValueError, match=r"tracks.*geo_east"):
         score_tracks(tracks, truth, positions={"g": ("geo_east", "geo_north")})
+
+
+def test_ranges_of_a_moving_platform_are_taken_from_each_rows_camera(tmp_path: Path) -> None:
+    # the platform sails east at 10 m/s; a ship stays 1000 m due north of it, the track
+    # reads it 1050 m north: +5 % range in every frame (ranges from the fixed origin would
+    # give 1000..1050 m true ranges and a varying error)
+    rows = []
+    for f in range(FRAMES):
+        rows.append(
+            dict(time=f, frame=f, object_id=1, x=100, y=200, w=40, h=12,
+                 east_m=10.0 * f, north_m=1000.0, platform_east_m=10.0 * f,
+                 platform_north_m=0.0)
+        )  # fmt: skip
+    truth = _write(tmp_path / "truth_world.csv", rows)
+    tracks = _as_tracks(rows)
+    for t in tracks:
+        t["north_m"] = 1050.0
+    res = _score(tmp_path, truth, tracks)
+    assert res.rmse_range_percent == pytest.approx(5.0, abs=1e-9)
+    assert res.rmse_position_m == pytest.approx(50.0, abs=1e-9)

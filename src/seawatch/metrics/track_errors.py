@@ -482,14 +482,15 @@ def _position_errors(
     columns: tuple[str, str],
     est: FloatArray,
     truth: FloatArray,
-    centre: tuple[float, float],
+    origin: FloatArray,
     bins: Sequence[float],
     where: tuple[np.ndarray, np.ndarray, np.ndarray],
 ) -> PositionErrors:
-    """Errors of estimates ``est`` (P, 2) (east, north) against ``truth`` (P, 2)."""
+    """Errors of estimates ``est`` (P, 2) (east, north) against ``truth`` (P, 2); ranges
+    from the camera foot point ``origin`` (P, 2) (east, north) of each pair [m]."""
     ok = np.all(np.isfinite(est), axis=1)
     e, t = est[ok], truth[ok]
-    c = np.array([centre[1], centre[0]])  # (east, north)
+    c = origin[ok]
     err = np.hypot(*(e - t).T)
     r = np.hypot(*(t - c).T)
     r_hat = np.hypot(*(e - c).T)
@@ -606,6 +607,14 @@ def score_tracks(
     if np.any(~np.all(np.isfinite(g_box), axis=1)):
         raise ValueError(f"truth {truth.path}: a box (x, y, w, h) is empty or not finite")
     centre = _camera_position(camera, Path(truth_csv))
+    # ranges from the camera of each truth row: a moving platform's truth carries its
+    # position (platform_north_m, platform_east_m); a fixed camera's is ``centre``
+    g_origin = np.tile([centre[1], centre[0]], (truth.rows, 1))
+    if "platform_east_m" in truth.columns and "platform_north_m" in truth.columns:
+        pe = _floats("truth", truth, "platform_east_m")
+        pn = _floats("truth", truth, "platform_north_m")
+        known = np.isfinite(pe) & np.isfinite(pn)
+        g_origin[known] = np.stack([pe[known], pn[known]], -1)
     steps = None if frames is None else np.unique(np.asarray(frames, dtype=np.int64))
 
     # rows in scope: chosen frames; track rows without a box cannot be matched (dropped)
@@ -654,13 +663,13 @@ def score_tracks(
     results: dict[str, PositionErrors] = {}
     for name, est in wide.items():
         results[name] = _position_errors(
-            name, pos_cols[name], est[ti], g_en[gi], centre, edges, where
+            name, pos_cols[name], est[ti], g_en[gi], g_origin[gi], edges, where
         )
     est_file = None
     if estimates is not None:
         est_file = str(estimates)
         results.update(
-            _long_form(estimates, estimate_columns, where, g_en[gi], centre, edges, results)
+            _long_form(estimates, estimate_columns, where, g_en[gi], g_origin[gi], edges, results)
         )
     first = next(iter(results.values()))
 
@@ -742,7 +751,7 @@ def _long_form(
     columns: tuple[str, str],
     where: tuple[np.ndarray, np.ndarray, np.ndarray],
     truth_en: FloatArray,
-    centre: tuple[float, float],
+    origin: FloatArray,
     edges: FloatArray,
     taken: Mapping[str, PositionErrors],
 ) -> dict[str, PositionErrors]:
@@ -775,5 +784,5 @@ def _long_form(
             if k is not None:
                 est[k] = (east[i], north[i])
         label = name if name not in taken else f"{name} (estimates)"
-        out[label] = _position_errors(label, columns, est, truth_en, centre, edges, where)
+        out[label] = _position_errors(label, columns, est, truth_en, origin, edges, where)
     return out
