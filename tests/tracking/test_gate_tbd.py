@@ -173,6 +173,105 @@ def test_docstring_example():
 
 
 # --------------------------------------------------------------------------------------
+# §8.2's alternative: orthogonal linearity test, seed exclusion of every extending mark
+# --------------------------------------------------------------------------------------
+
+
+def svd_residual(points):
+    """sqrt(Σ d_⊥² / (m − 2)) of the total-least-squares line, from numpy's SVD."""
+    xy = np.asarray(points, float)
+    sv = np.linalg.svd(xy - xy.mean(axis=0), compute_uv=False)
+    return math.sqrt(sv[-1] ** 2 / (len(xy) - 2))
+
+
+def test_orthogonal_kernel_equals_the_smallest_singular_value_of_the_centred_points():
+    from seawatch.tracking.gate_tbd import _branch_orth
+
+    rng = np.random.default_rng(1234)
+    for trial in range(300):
+        m = int(rng.integers(3, 6))
+        if trial % 3 == 0:  # nearly collinear, far from the origin, fast: precision check
+            base, v = rng.uniform(0, 1900, 2), rng.uniform(-80, 80, 2)
+            pts = base + np.arange(m)[:, None] * v + rng.integers(-1, 2, (m, 2))
+        else:
+            pts = rng.integers(0, 1080, (m, 2)).astype(float)
+        hist = np.zeros((1, 5, 2))
+        hist[0, : m - 1] = pts[:-1]
+        htime = np.arange(5)[None, :]
+        got, got_m = _branch_orth(hist, htime, 0, m - 1, 5, pts[-1, 0], pts[-1, 1])
+        xy = pts - pts.mean(axis=0)
+        want = np.linalg.svd(xy, compute_uv=False)[-1] ** 2
+        assert got_m == m
+        assert got == pytest.approx(want, rel=1e-9, abs=1e-7)
+
+
+def test_orthogonal_test_accepts_exactly_the_tracks_within_eps_of_the_svd_line():
+    # N = 3: confirmation at frame 2 iff the third mark is in the small gate and the
+    # three marks' TLS residual is <= 1.96 px (ties skipped), whatever the spacing
+    rng = np.random.default_rng(1234)
+    seen = {True: 0, False: 0}
+    for _ in range(150):
+        z0 = rng.integers(200, 800, 2)
+        z1 = z0 + rng.integers(-80, 81, 2)
+        z2 = 2 * z1 - z0 + rng.integers(-11, 12, 2)
+        want = svd_residual([z0, z1, z2])
+        if abs(want - 1.96) < 1e-6:
+            continue
+        tbd = GateTBD(FRAME, n_frames=3, linearity="orthogonal")
+        outs, _ = push_all(tbd, [[z0], [z1], [z2]])
+        assert (outs[2].shape[0] == 1) == (want <= 1.96)
+        seen[want <= 1.96] += 1
+    assert min(seen.values()) > 20  # both outcomes exercised
+
+
+def test_orthogonal_test_ignores_spacing_along_the_line_but_not_lateral_offsets():
+    # (0,0), (0,10), (0,30): collinear, 10 px past the CV prediction (inside the 23-px gate)
+    along = [[[500, 500]], [[500, 510]], [[500, 530]]]
+    # (0,0), (0,10), (5,20): 5 px lateral offset, TLS residual > 1.96 px
+    lateral = [[[500, 500]], [[500, 510]], [[505, 520]]]
+    assert svd_residual([[500, 500], [500, 510], [505, 520]]) > 1.96
+    for frames, pooled, orth in ((along, False, True), (lateral, True, False)):
+        a, _ = push_all(GateTBD(FRAME, n_frames=3), frames)  # default: pooled LS, 2.55 px
+        b, _ = push_all(GateTBD(FRAME, n_frames=3, linearity="orthogonal"), frames)
+        assert (a[2].shape[0] == 1, b[2].shape[0] == 1) == (pooled, orth)
+
+
+def test_extended_seed_exclusion_removes_marks_that_extended_a_tentative_track():
+    # N = 5: the frame-2 mark extends the pair (0, 1) to a 3-mark tentative track.
+    # "confirmed" still seeds with it (one new pair at frame 3); "extended" does not.
+    frames = line((300, 300), (4, 6), 4)
+    pairs = {}
+    for rule in ("confirmed", "extended", "none", True, False):
+        _, stats = push_all(GateTBD(FRAME, n_frames=5, seed_exclusion=rule), frames)
+        pairs[rule] = [s.pairs for s in stats]
+    assert pairs["confirmed"] == pairs[True] == pairs["none"] == pairs[False] == [0, 1, 1, 1]
+    assert pairs["extended"] == [0, 1, 1, 0]
+
+
+def test_default_is_the_spec_rule_with_unchanged_threshold_and_attributes():
+    tbd = GateTBD(FRAME)
+    assert (tbd.linearity, tbd.linearity_threshold) == ("pooled-ls", 2.55)
+    assert (tbd.seed_rule, tbd.seed_exclusion) == ("confirmed", True)
+    assert GateTBD(FRAME, linearity="orthogonal").linearity_threshold == 1.96
+    literal = GateTBD(FRAME, seed_exclusion=False)
+    assert (literal.seed_rule, literal.seed_exclusion) == ("none", False)
+    # explicit spec settings give identical per-frame outputs on random clutter + targets
+    rng = np.random.default_rng(1234)
+    frames = random_case(rng, 15, (200, 300), n_clutter=60, n_targets=4)
+    a = GateTBD((200, 300), n_frames=3).run(frames)
+    b = GateTBD(
+        (200, 300),
+        n_frames=3,
+        linearity="pooled-ls",
+        linearity_threshold=2.55,
+        seed_exclusion="confirmed",
+    ).run(frames)
+    np.testing.assert_array_equal(a.detections, b.detections)
+    np.testing.assert_array_equal(a.new_tracks, b.new_tracks)
+    assert a.new_tracks.sum() > 0
+
+
+# --------------------------------------------------------------------------------------
 # brute-force reference implementation of §8.1 (with the module's documented choices)
 # --------------------------------------------------------------------------------------
 
@@ -190,9 +289,31 @@ def ls_fit(pts):
     return ssr, slopes
 
 
-def reference(frames, frame_size, large_gate, small_gate, n, eps, seed_exclusion=True):
+def orth_fit(pts):
+    """Σ d_⊥² of the total-least-squares line through the (r, c) of (t, r, c) points: the
+    smallest squared singular value of the centred points (numpy SVD)."""
+    xy = np.array([p[1:] for p in pts], float)
+    return float(np.linalg.svd(xy - xy.mean(axis=0), compute_uv=False)[-1] ** 2)
+
+
+def reference(
+    frames,
+    frame_size,
+    large_gate,
+    small_gate,
+    n,
+    eps,
+    seed_exclusion=True,
+    linearity="pooled-ls",
+    seed_rule=None,
+):
     """Literal per-track loops over every mark: per frame, the detections as {id: row}
-    and (new_tracks, new_marks)."""
+    and (new_tracks, new_marks). ``linearity="orthogonal"``: the SVD line of
+    :func:`orth_fit` with ``sqrt(Σ d_⊥² / (m − 2)) ≤ eps`` accepts (a confirmed track
+    still keeps the branch with the smallest LS SSR); ``seed_rule="extended"``: every
+    mark that extended any track is excluded from seeding."""
+    if seed_rule is None:
+        seed_rule = "confirmed" if seed_exclusion else "none"
     a_b, a_s = (large_gate - 1) // 2, (small_gate - 1) // 2
     tracks = []  # dicts: pts [(t, r, c)], id
     prev, prev_used, next_id = [], set(), 1
@@ -208,10 +329,14 @@ def reference(frames, frame_size, large_gate, small_gate, n, eps, seed_exclusion
             for i, (r, c) in enumerate(z):
                 if abs(r - pr) <= a_s and abs(c - pc) <= a_s:
                     window = ([*pts, (k, r, c)])[-n:]
-                    ssr, _ = ls_fit(window)
-                    if math.sqrt(ssr / (2 * len(window) - 4)) <= eps + 1e-9:
+                    ssr = ls_fit(window)[0]  # branches rank by the LS line in time
+                    if linearity == "orthogonal":
+                        res, dof = orth_fit(window), len(window) - 2
+                    else:
+                        res, dof = ssr, 2 * len(window) - 4
+                    if math.sqrt(res / dof) <= eps + 1e-9:
                         acc.append((ssr, i))
-            if len(pts) + 1 >= n:
+            if len(pts) + 1 >= n or seed_rule == "extended":
                 used |= {i for _, i in acc}
             if len(pts) >= n and acc:  # best fit; SSR equal to 6 decimals: lower index
                 acc = [min(acc, key=lambda a: (round(a[0], 6), a[1]))]
@@ -238,7 +363,7 @@ def reference(frames, frame_size, large_gate, small_gate, n, eps, seed_exclusion
         out.append((dets, stats))
         pairs = []
         for s_i, s in enumerate(prev):
-            if seed_exclusion and s_i in prev_used:
+            if seed_rule != "none" and s_i in prev_used:
                 continue
             for m_i, m in enumerate(z):
                 if max(abs(m[0] - s[0]), abs(m[1] - s[1])) <= a_b:
@@ -270,16 +395,40 @@ def random_case(rng, frames, size, n_clutter, n_targets):
 
 
 @pytest.mark.parametrize(
-    ("n", "large", "small", "eps", "seed_exclusion"),
-    [(3, 21, 7, 1.0, True), (4, 21, 9, 1.5, True), (3, 15, 7, 0.8, False), (5, 25, 9, 2.55, True)],
+    ("n", "large", "small", "eps", "seed_exclusion", "linearity"),
+    [
+        (3, 21, 7, 1.0, True, "pooled-ls"),
+        (4, 21, 9, 1.5, True, "pooled-ls"),
+        (3, 15, 7, 0.8, False, "pooled-ls"),
+        (5, 25, 9, 2.55, True, "pooled-ls"),
+        # ALGORITHMS.md §8.2's alternative: orthogonal line, extended seed exclusion
+        (3, 21, 7, 0.7, "extended", "orthogonal"),
+        (4, 21, 9, 1.0, "extended", "orthogonal"),
+        (5, 25, 9, 1.96, "extended", "orthogonal"),
+        (4, 21, 9, 1.0, "confirmed", "orthogonal"),
+        (4, 21, 9, 1.5, "extended", "pooled-ls"),
+    ],
 )
-def test_per_frame_outputs_equal_a_brute_force_reference(n, large, small, eps, seed_exclusion):
+def test_per_frame_outputs_equal_a_brute_force_reference(
+    n, large, small, eps, seed_exclusion, linearity
+):
     rng = np.random.default_rng(1234)
     size = (40, 60)
+    rule = seed_exclusion if isinstance(seed_exclusion, str) else None
     for _ in range(3):
         frames = random_case(rng, 12, size, n_clutter=12, n_targets=3)
-        ref = reference(frames, size, large, small, n, eps, seed_exclusion)
-        tbd = GateTBD(size, large, small, n, linearity_threshold=eps, seed_exclusion=seed_exclusion)
+        ref = reference(
+            frames, size, large, small, n, eps, seed_exclusion is not False, linearity, rule
+        )
+        tbd = GateTBD(
+            size,
+            large,
+            small,
+            n,
+            linearity_threshold=eps,
+            seed_exclusion=seed_exclusion,
+            linearity=linearity,
+        )
         id_map: dict[int, set[int]] = {}
         confirmations = 0
         for z, (want, stats) in zip(frames, ref, strict=True):
@@ -375,6 +524,10 @@ def test_bad_marks_raise_value_error_naming_marks():
         ({"linearity_threshold": -1}, "linearity_threshold"),
         ({"max_branches": 0}, "max_branches"),
         ({"max_tracks": 1.5}, "max_tracks"),
+        ({"linearity": "svd"}, "linearity"),
+        ({"linearity": None}, "linearity"),
+        ({"seed_exclusion": "sometimes"}, "seed_exclusion"),
+        ({"seed_exclusion": 1}, "seed_exclusion"),
     ],
 )
 def test_bad_configuration_raises_value_error_naming_the_argument(kwargs, name):

@@ -115,6 +115,13 @@ def experiment(
         str | None,
         typer.Option(help="clutter-tbd: 1, 2, fig4, crossing, splitting or all."),
     ] = None,
+    variant: Annotated[
+        str | None,
+        typer.Option(
+            help="clutter-tbd: the linearity test, orthogonal (default: ALGORITHMS.md §8.2's "
+            "alternative) or spec (§8.1's pooled LS residual)."
+        ),
+    ] = None,
     ais: Annotated[Path | None, typer.Option(help="solent-ais: AIS CSV or NMEA file.")] = None,
     camera_lat: Annotated[
         float | None, typer.Option(help="solent-ais: camera latitude (deg).")
@@ -162,6 +169,7 @@ def experiment(
             kwargs["runs"] = runs
         scenario_options = {
             "table": table,
+            "variant": variant,
             "ais": ais,
             "camera_lat": camera_lat,
             "camera_lon": camera_lon,
