@@ -277,25 +277,24 @@ def _angles(
     return np.asarray(az, float) % (2 * math.pi), -np.asarray(el, float), cov
 
 
-def _geodetic(north: np.ndarray, east: np.ndarray, lat0: Any, lon0: Any) -> tuple[Any, Any]:
-    if lat0 is None or lon0 is None:
-        return None, None
-    ok = np.isfinite(north) & np.isfinite(east)
-    lat = np.full(north.shape, np.nan)
-    lon = np.full(north.shape, np.nan)
-    if np.any(ok):
-        la, lo = north_east_to_geodetic(np.stack([north[ok], east[ok]], -1), lat0, lon0)
-        lat[ok], lon[ok] = la, lo
-    return lat, lon
+_GEO_KEYS: tuple[tuple[str, str, str, str], ...] = (
+    ("north_m", "east_m", "lat", "lon"),
+    *(
+        (f"forecast_north_m_{t:g}s", f"forecast_east_m_{t:g}s", f"forecast_lat_{t:g}s",
+         f"forecast_lon_{t:g}s")
+        for t in FORECAST_HORIZONS
+    ),
+)  # fmt: skip
+"""(north, east) cell pairs and the (lat, lon) cells they give."""
 
 
-def _estimate_cells(est: WorldEstimates, k: int, lat0: Any, lon0: Any) -> dict[str, Any]:
-    """The position, motion and forecast cells of track ``k`` of one estimator."""
-    n, e = float(est.north[k]), float(est.east[k])
+def _estimate_cells(est: WorldEstimates, k: int) -> dict[str, Any]:
+    """The position, motion and forecast cells of track ``k`` of one estimator (lat/lon
+    come later, for all rows of a frame at once: :func:`_add_geodetic`)."""
     cov = est.covariance[k]
     cells: dict[str, Any] = {
-        "north_m": n,
-        "east_m": e,
+        "north_m": float(est.north[k]),
+        "east_m": float(est.east[k]),
         "range_m": float(est.range[k]),
         "sigma_range_m": float(est.sigma_range[k]),
         "sigma_north_m": math.sqrt(cov[0, 0]) if cov[0, 0] >= 0 else math.nan,
@@ -304,20 +303,31 @@ def _estimate_cells(est: WorldEstimates, k: int, lat0: Any, lon0: Any) -> dict[s
         "course_deg": math.degrees(float(est.course[k])),
         "nis": None if est.nis is None else float(est.nis[k]),
     }
-    lat, lon = _geodetic(np.array([n]), np.array([e]), lat0, lon0)
-    if lat is not None:
-        cells["lat"], cells["lon"] = float(lat[0]), float(lon[0])
     for tau in FORECAST_HORIZONS:
-        s = f"{tau:g}s"
         f = est.forecasts.get(tau)
-        if f is None:
-            continue
-        fn, fe = float(f[k, 0]), float(f[k, 1])
-        cells[f"forecast_north_m_{s}"], cells[f"forecast_east_m_{s}"] = fn, fe
-        lat, lon = _geodetic(np.array([fn]), np.array([fe]), lat0, lon0)
-        if lat is not None:
-            cells[f"forecast_lat_{s}"], cells[f"forecast_lon_{s}"] = float(lat[0]), float(lon[0])
+        if f is not None:
+            cells[f"forecast_north_m_{tau:g}s"] = float(f[k, 0])
+            cells[f"forecast_east_m_{tau:g}s"] = float(f[k, 1])
     return cells
+
+
+def _add_geodetic(rows: list[dict[str, Any]], lat0: Any, lon0: Any) -> None:
+    """Fill the lat/lon cells of ``rows`` from their north/east cells, one geodesy call."""
+    if lat0 is None or lon0 is None or not rows:
+        return
+    where: list[tuple[int, str, str]] = []
+    ne: list[tuple[float, float]] = []
+    for i, row in enumerate(rows):
+        for kn, ke, klat, klon in _GEO_KEYS:
+            n, e = row.get(kn), row.get(ke)
+            if n is not None and e is not None and math.isfinite(n) and math.isfinite(e):
+                where.append((i, klat, klon))
+                ne.append((n, e))
+    if not ne:
+        return
+    lat, lon = north_east_to_geodetic(np.array(ne), lat0, lon0)
+    for (i, klat, klon), la, lo in zip(where, np.atleast_1d(lat), np.atleast_1d(lon), strict=True):
+        rows[i][klat], rows[i][klon] = float(la), float(lo)
 
 
 # ------------------------------------------------------------------------------ the job
@@ -516,12 +526,15 @@ def track_video(
                         rec["azimuth_deg"] = math.degrees(float(az[i]))
                         rec["depression_deg"] = math.degrees(float(dep[i]))
                         rec["estimator"] = estimator
-                        rec.update(_estimate_cells(best, i, lat0, lon0))
-                    for name, est in estimates.items():
-                        for i, rec in enumerate(records):
-                            est_out.write(  # type: ignore[union-attr]
-                                {**rec, "estimator": name, **_estimate_cells(est, i, lat0, lon0)}
-                            )
+                        rec.update(_estimate_cells(best, i))
+                    est_rows = [
+                        {**rec, "estimator": name, **_estimate_cells(est, i)}
+                        for name, est in estimates.items()
+                        for i, rec in enumerate(records)
+                    ]
+                    _add_geodetic(records + est_rows, lat0, lon0)
+                    for row in est_rows:
+                        est_out.write(row)  # type: ignore[union-attr]
                     if associator is not None and frames % ais_every == 0:
                         view = _view_wedge(cam, ppose)
                         vel = np.stack(

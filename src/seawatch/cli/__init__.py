@@ -224,6 +224,8 @@ BENCHMARKS = {
     "reference implementation",
     "mtt": "ship multi-target tracker: 10 targets + 50 clutter points per scan, vs one filter "
     "object per track",
+    "video": "image stage and track job at 1920x1080: decode, +horizon, +detect, +track and "
+    "track_video (decode -> tracks.csv) on a rendered four-ship clip, vs decode alone",
 }
 
 
@@ -233,8 +235,8 @@ def bench(
     size: Annotated[
         int | None,
         typer.Option(
-            help="Problem length: steps (filters), frames (tbd) or scans (mtt); default: the "
-            "issue's size."
+            help="Problem length: steps (filters), frames (tbd, video) or scans (mtt); default: "
+            "the issue's size."
         ),
     ] = None,
     repeats: Annotated[int, typer.Option(help="Timing repeats (best of).", min=1)] = 3,
@@ -248,8 +250,9 @@ def bench(
     100,000 steps) through seawatch's filter() and per-step API, FilterPy and a plain
     numpy loop, plus 10,000 tracks filtered at once. [bold]tbd[/]: the gate
     track-before-detect on 1080x1920 frames with 300 clutter marks. [bold]mtt[/]: the ship
-    tracker on 10 targets + 50 clutter points per scan. Each fails (exit 1) if its fast
-    path disagrees with its reference.
+    tracker on 10 targets + 50 clutter points per scan. [bold]video[/]: decode, horizon,
+    detection, visual tracking and the whole track job on a rendered 1080p clip. Each fails
+    (exit 1) if its fast path disagrees with its reference.
 
     Example: [cyan]seawatch bench filters --json[/]
     """
@@ -261,8 +264,10 @@ def bench(
         module = importlib.import_module(f"seawatch.bench.{name}")
         kwargs: dict[str, object] = {}
         if size is not None:
-            kwargs[{"filters": "steps", "tbd": "frames", "mtt": "scans"}[name]] = size
-        if name in ("filters", "mtt"):
+            kwargs[
+                {"filters": "steps", "tbd": "frames", "mtt": "scans", "video": "frames"}[name]
+            ] = size
+        if name in ("filters", "mtt", "video"):
             kwargs["repeats"] = repeats
         with progress_bar() as bar:
             task = bar.add_task(f"bench {name}", total=None)

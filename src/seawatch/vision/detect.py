@@ -179,12 +179,12 @@ class Detector(Protocol):
 # --------------------------------------------------------------------------------------
 
 
-def _gray(image: ArrayLike) -> tuple[NDArray, float, NDArray | None]:
-    """The frame as one grey channel (uint8, uint16 or float32), its quantum [units] and
-    the BGR colour frame (None for grey input).
+def _image_planes(image: ArrayLike) -> tuple[NDArray | None, float, NDArray | None]:
+    """The validated frame: its grey channel (uint8, uint16 or float32; None for a colour
+    frame), its quantum [units] and the BGR colour frame (None for grey input).
 
-    Colour is BGR(A) → luma (ITU-R BT.601 weights, ``cv2.cvtColor``). Raises ValueError
-    naming ``image`` for a wrong shape or dtype, an empty or tiny frame, or NaN pixels.
+    Raises ValueError naming ``image`` for a wrong shape or dtype, an empty or tiny frame,
+    or NaN pixels.
     """
     arr = np.asarray(image)
     if arr.dtype == np.bool_:
@@ -193,31 +193,41 @@ def _gray(image: ArrayLike) -> tuple[NDArray, float, NDArray | None]:
         raise ValueError(f"image: expected an integer or float image, got dtype {arr.dtype}")
     if arr.ndim == 3 and arr.shape[2] == 1:
         arr = arr[:, :, 0]
-    colour = None
-    if arr.ndim == 3 and arr.shape[2] in (3, 4):
-        if arr.dtype not in (np.uint8, np.uint16, np.float32):
-            arr = arr.astype(np.float32)
-        arr = np.ascontiguousarray(arr)
-        if arr.shape[2] == 4:
-            arr = cv2.cvtColor(arr, cv2.COLOR_BGRA2BGR)
-        colour = arr
-        arr = cv2.cvtColor(arr, cv2.COLOR_BGR2GRAY)
-    if arr.ndim != 2:
+    if not (arr.ndim == 2 or (arr.ndim == 3 and arr.shape[2] in (3, 4))):
         raise ValueError(
             f"image: expected a (H, W) grey or (H, W, 3|4) BGR(A) image, got shape {arr.shape}"
         )
     if arr.shape[0] < 8 or arr.shape[1] < 8:
-        raise ValueError(f"image: expected at least 8×8 pixels, got shape {arr.shape}")
+        raise ValueError(f"image: expected at least 8×8 pixels, got shape {arr.shape[:2]}")
     quantum = 1.0
-    if arr.dtype not in (np.uint8, np.uint16):
-        quantum = 1.0 if arr.dtype.kind in "ui" else 0.0
+    if arr.dtype not in (np.uint8, np.uint16, np.float32):
+        # integer grey levels keep a quantum of 1; colour is converted to float first
+        quantum = 1.0 if arr.dtype.kind in "ui" and arr.ndim == 2 else 0.0
         arr = arr.astype(np.float32)
-        if not math.isfinite(float(arr.sum(dtype=np.float64))):
-            raise ValueError("image: contains NaN or inf pixels")
-    if colour is not None and colour.dtype == np.float32:
-        if not math.isfinite(float(colour.sum(dtype=np.float64))):
-            raise ValueError("image: contains NaN or inf pixels")
-    return np.ascontiguousarray(arr), quantum, colour
+    elif arr.dtype == np.float32:
+        quantum = 0.0
+    arr = np.ascontiguousarray(arr)
+    if arr.ndim == 3 and arr.shape[2] == 4:
+        arr = cv2.cvtColor(arr, cv2.COLOR_BGRA2BGR)
+    if arr.dtype == np.float32 and not math.isfinite(float(arr.sum(dtype=np.float64))):
+        raise ValueError("image: contains NaN or inf pixels")
+    if arr.ndim == 2:
+        return arr, quantum, None
+    return None, quantum, arr
+
+
+def _gray(image: ArrayLike) -> tuple[NDArray, float, NDArray | None]:
+    """The frame as one grey channel (uint8, uint16 or float32), its quantum [units] and
+    the BGR colour frame (None for grey input).
+
+    Colour is BGR(A) → luma (ITU-R BT.601 weights, ``cv2.cvtColor``). Raises ValueError
+    naming ``image`` for a wrong shape or dtype, an empty or tiny frame, or NaN pixels.
+    """
+    grey, quantum, colour = _image_planes(image)
+    if grey is None:
+        assert colour is not None
+        grey = cv2.cvtColor(colour, cv2.COLOR_BGR2GRAY)
+    return grey, quantum, colour
 
 
 def _horizon_ends(horizon: Any, width: int) -> tuple[float, float] | None:
@@ -283,126 +293,237 @@ def sea_region(shape: tuple[int, int], horizon: Any) -> NDArray[np.bool_]:
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def _contrast_kernel(  # pragma: no cover - compiled
-    gs, v3, q3, r0, r1, guard, flank, polarity, hi, lo, d, c, tex
+    gs, b5, r0, r1, guard, flank, polarity, hi, lo, d, c, tex
 ):
     """Greatest-of CFAR contrast and least-of clutter level, rows ``r0 … r1 − 1``.
 
-    ``v3``/``q3`` are the 3-row sums of the smoothed plane ``gs`` and of the squared
-    local detail ``e² = (gs − box5(gs))²``. Per pixel: ``L``/``R`` = mean of ``gs`` over
-    the 3-row × ``flank``-column training windows that end ``guard`` columns left / start
-    ``guard`` columns right of it (a side that leaves the image takes the other side's
-    value); ``hi = max(L, R)``, ``lo = min(L, R)``, ``d = g − (L + R)/2``, contrast
-    ``c = g − hi`` (polarity 1, bright), ``lo − g`` (2, dark) or the larger (0, both);
-    ``tex = sqrt(min(E_L, E_R))`` with ``E`` the mean of ``e²`` over the same windows.
+    ``gs`` is the smoothed plane and ``b5`` its 5 × 5 box mean; ``e² = (gs − b5)²`` is
+    the squared local detail. Per pixel: ``L``/``R`` = mean of ``gs`` over the 3-row ×
+    ``flank``-column training windows that end ``guard`` columns left / start ``guard``
+    columns right of it (rows past the top and bottom repeat the edge rows; a side that
+    leaves the image takes the other side's value); ``hi = max(L, R)``,
+    ``lo = min(L, R)``, ``d = g − (L + R)/2``, contrast ``c = g − hi`` (polarity 1,
+    bright), ``lo − g`` (2, dark) or the larger (0, both); ``tex = sqrt(min(E_L, E_R))``
+    with ``E`` the mean of ``e²`` over the same windows.
     """
-    W = gs.shape[1]
+    H, W = gs.shape
     P = np.empty(W + 1)
     Q = np.empty(W + 1)
-    n = 3.0 * flank
+    v = np.empty(W)
+    q = np.empty(W)
+    L = np.empty(W)
+    R = np.empty(W)
+    EL = np.empty(W)
+    ER = np.empty(W)
+    inv_n = 1.0 / (3.0 * flank)
+    jl = guard + flank  # first column with a left window
+    jr = W - guard - flank - 1  # last column with a right window
     for r in range(r0, r1):
+        g0 = gs[max(r - 1, 0)]
+        g1 = gs[r]
+        g2 = gs[min(r + 1, H - 1)]
+        m0 = b5[max(r - 1, 0)]
+        m1 = b5[r]
+        m2 = b5[min(r + 1, H - 1)]
+        for j in range(W):  # 3-row sums of gs and e²
+            e0 = g0[j] - m0[j]
+            e1 = g1[j] - m1[j]
+            e2 = g2[j] - m2[j]
+            v[j] = np.float64(g0[j]) + np.float64(g1[j]) + np.float64(g2[j])
+            q[j] = np.float64(e0 * e0) + np.float64(e1 * e1) + np.float64(e2 * e2)
         acc = 0.0
         acc2 = 0.0
         P[0] = 0.0
         Q[0] = 0.0
         for j in range(W):
-            acc += v3[r, j]
-            acc2 += q3[r, j]
+            acc += v[j]
+            acc2 += q[j]
             P[j + 1] = acc
             Q[j + 1] = acc2
-        for j in range(W):
-            a0 = j - guard - flank
-            b1 = j + guard + 1 + flank
-            has_l = a0 >= 0
-            has_r = b1 <= W
-            left = 0.0
-            el = 0.0
-            right = 0.0
-            er = 0.0
-            if has_l:
-                left = (P[j - guard] - P[a0]) / n
-                el = (Q[j - guard] - Q[a0]) / n
-            if has_r:
-                right = (P[b1] - P[j + guard + 1]) / n
-                er = (Q[b1] - Q[j + guard + 1]) / n
-            if not has_l:
-                if has_r:
-                    left = right
-                    el = er
-                else:
-                    left = P[W] / (3.0 * W)
-                    el = Q[W] / (3.0 * W)
-            if not has_r:
-                right = left
-                er = el
-            g = np.float64(gs[r, j])
-            h = max(left, right)
-            lw = min(left, right)
-            hi[r, j] = h
-            lo[r, j] = lw
-            d[r, j] = g - 0.5 * (left + right)
-            tex[r, j] = np.sqrt(max(0.0, min(el, er)))
-            if polarity == 1:
-                c[r, j] = g - h
-            elif polarity == 2:
-                c[r, j] = lw - g
+        n_in = min(jr, W - 1) + 1 - jl  # columns jl … with both windows inside
+        if n_in > 0:
+            # slices, so that the loop runs from 0 over contiguous memory (vectorised):
+            # the left window of column jl + k is P[k + flank] − P[k], the right one
+            # P[jl + guard + 1 + flank + k] − P[jl + guard + 1 + k]
+            La, ELa, Ra, ERa = L[jl:], EL[jl:], R[jl:], ER[jl:]
+            p0, p1 = P[:], P[flank:]
+            q0, q1 = Q[:], Q[flank:]
+            pr0, pr1 = P[jl + guard + 1 :], P[jl + guard + 1 + flank :]
+            qr0, qr1 = Q[jl + guard + 1 :], Q[jl + guard + 1 + flank :]
+            for k in range(n_in):
+                La[k] = (p1[k] - p0[k]) * inv_n
+                ELa[k] = (q1[k] - q0[k]) * inv_n
+                Ra[k] = (pr1[k] - pr0[k]) * inv_n
+                ERa[k] = (qr1[k] - qr0[k]) * inv_n
+        for j in range(0, min(jl, W)):  # no left window: the right one, or the row mean
+            if j <= jr:
+                R[j] = (P[j + guard + 1 + flank] - P[j + guard + 1]) * inv_n
+                ER[j] = (Q[j + guard + 1 + flank] - Q[j + guard + 1]) * inv_n
             else:
-                c[r, j] = max(g - h, lw - g)
+                R[j] = P[W] / (3.0 * W)
+                ER[j] = Q[W] / (3.0 * W)
+            L[j] = R[j]
+            EL[j] = ER[j]
+        for j in range(max(jr + 1, jl, 0), W):  # no right window: the left one
+            L[j] = (P[j - guard] - P[j - guard - flank]) * inv_n
+            EL[j] = (Q[j - guard] - Q[j - guard - flank]) * inv_n
+            R[j] = L[j]
+            ER[j] = EL[j]
+        hr = hi[r]
+        lr = lo[r]
+        dr = d[r]
+        cr = c[r]
+        tr = tex[r]
+        for j in range(W):
+            g = np.float64(g1[j])
+            h = max(L[j], R[j])
+            lw = min(L[j], R[j])
+            hr[j] = h
+            lr[j] = lw
+            dr[j] = g - 0.5 * (L[j] + R[j])
+            tr[j] = np.sqrt(max(0.0, min(EL[j], ER[j])))
+            if polarity == 1:
+                cr[j] = g - h
+            elif polarity == 2:
+                cr[j] = lw - g
+            else:
+                cr[j] = max(g - h, lw - g)
 
 
 @njit(cache=True, nogil=True)
-def _grow_kernel(z, seeds, grow, visited, queue):  # pragma: no cover - compiled
-    """Hysteresis segmentation from seed pixels: the 8-connected components of
-    ``z > grow`` that hold a seed, found by breadth-first flood fill (cost ∝ their size).
+def _grow_kernel(z, threshold, border, grow, visited, queue):  # pragma: no cover - compiled
+    """Hysteresis segmentation: the 8-connected components of ``z > grow`` that hold a
+    seed ``z > threshold`` (seeds in row-major order; none within ``border`` pixels of the
+    left, right and bottom edges), found by breadth-first flood fill (cost ∝ their size).
 
-    ``seeds`` are flat pixel indices; ``visited`` (uint8, flat, all zero) and ``queue``
-    (flat, size ≥ H·W) are work buffers, ``visited`` is zero again on return. Returns
-    the inclusive boxes ``(c0, r0, c1, r1)``, peak ``z`` and area [px] per component.
+    ``visited`` (uint8, flat, all zero) and ``queue`` (flat, size ≥ H·W) are work
+    buffers, ``visited`` is zero again on return. Returns the inclusive boxes
+    ``(c0, r0, c1, r1)``, peak ``z`` and area [px] per component.
     """
     H, W = z.shape
-    n = seeds.shape[0]
-    boxes = np.empty((n, 4), np.int64)
-    peaks = np.empty(n, np.float32)
-    areas = np.empty(n, np.int64)
+    cap = 64
+    boxes = np.empty((cap, 4), np.int64)
+    peaks = np.empty(cap, np.float32)
+    areas = np.empty(cap, np.int64)
     k = 0
     top = 0
-    for s in range(n):
-        p = seeds[s]
-        if visited[p]:
-            continue
-        visited[p] = 1
-        start = top
-        queue[top] = p
-        top += 1
-        head = start
-        r0, r1, c0, c1 = H, -1, W, -1
-        pk = -np.inf
-        while head < top:
-            q = queue[head]
-            head += 1
-            r = q // W
-            c = q - r * W
-            r0 = min(r0, r)
-            r1 = max(r1, r)
-            c0 = min(c0, c)
-            c1 = max(c1, c)
-            pk = max(pk, z[r, c])
-            for rr in range(max(0, r - 1), min(H, r + 2)):
-                for cc in range(max(0, c - 1), min(W, c + 2)):
-                    qq = rr * W + cc
-                    if visited[qq] == 0 and z[rr, cc] > grow:
-                        visited[qq] = 1
-                        queue[top] = qq
-                        top += 1
-        boxes[k, 0] = c0
-        boxes[k, 1] = r0
-        boxes[k, 2] = c1
-        boxes[k, 3] = r1
-        peaks[k] = pk
-        areas[k] = top - start
-        k += 1
+    for sr in range(0, H - border):
+        zr = z[sr, border : max(border, W - border)]  # a slice: a fast scan from 0
+        for k0 in range(zr.shape[0]):
+            if not zr[k0] > threshold:
+                continue
+            sc = border + k0
+            p = sr * W + sc
+            if visited[p]:
+                continue
+            if k == cap:
+                cap *= 2
+                boxes2 = np.empty((cap, 4), np.int64)
+                boxes2[:k] = boxes[:k]
+                boxes = boxes2
+                peaks2 = np.empty(cap, np.float32)
+                peaks2[:k] = peaks[:k]
+                peaks = peaks2
+                areas2 = np.empty(cap, np.int64)
+                areas2[:k] = areas[:k]
+                areas = areas2
+            visited[p] = 1
+            start = top
+            queue[top] = p
+            top += 1
+            head = start
+            r0, r1, c0, c1 = H, -1, W, -1
+            pk = -np.inf
+            while head < top:
+                q = queue[head]
+                head += 1
+                r = q // W
+                c = q - r * W
+                r0 = min(r0, r)
+                r1 = max(r1, r)
+                c0 = min(c0, c)
+                c1 = max(c1, c)
+                pk = max(pk, z[r, c])
+                for rr in range(max(0, r - 1), min(H, r + 2)):
+                    for cc in range(max(0, c - 1), min(W, c + 2)):
+                        qq = rr * W + cc
+                        if visited[qq] == 0 and z[rr, cc] > grow:
+                            visited[qq] = 1
+                            queue[top] = qq
+                            top += 1
+            boxes[k, 0] = c0
+            boxes[k, 1] = r0
+            boxes[k, 2] = c1
+            boxes[k, 3] = r1
+            peaks[k] = pk
+            areas[k] = top - start
+            k += 1
     for i in range(top):
         visited[queue[i]] = 0
     return boxes[:k], peaks[:k], areas[:k]
+
+
+@njit(cache=True, nogil=True)
+def _shear_row(src, starts, fy, y, out):  # pragma: no cover - compiled
+    """One sheared row: ``out[c]`` = ``src`` at row ``y + k + fy[c]`` of column ``c``,
+    linearly interpolated between rows (rows past the edges repeat the edge row), ``k``
+    the whole-row shift of the run of columns ``c`` lies in (``starts``: first column and
+    shift of each run, the last row closing the runs)."""
+    h = src.shape[0]
+    for run in range(starts.shape[0] - 1):
+        c0 = starts[run, 0]
+        c1 = starts[run + 1, 0]
+        y0 = y + starts[run, 1]
+        # slices, so that the loop below runs from 0 over contiguous memory (vectorised)
+        ra = src[min(max(y0, 0), h - 1), c0:c1]
+        rb = src[min(max(y0 + 1, 0), h - 1), c0:c1]
+        f = fy[c0:c1]
+        o = out[c0:c1]
+        for c in range(c1 - c0):
+            a = np.float32(ra[c])
+            o[c] = a + f[c] * (np.float32(rb[c]) - a)
+
+
+@njit(cache=True, nogil=True)
+def _shear_kernel(src, starts, fy, r0, r1, out):  # pragma: no cover - compiled
+    """Rows ``r0 … r1 − 1`` of the sheared band: row ``i`` is :func:`_shear_row` at
+    ``y = i``."""
+    for i in range(r0, r1):
+        _shear_row(src, starts, fy, i, out[i])
+
+
+@njit(cache=True, nogil=True)
+def _shear_half_kernel(src, starts, fy, r0, r1, out):  # pragma: no cover - compiled
+    """Rows ``r0 … r1 − 1`` of the sheared band at half resolution: ``out[i, j]`` is the
+    mean of the sheared band (:func:`_shear_kernel`) over rows ``2i, 2i + 1`` and columns
+    ``2j, 2j + 1``."""
+    rows = np.empty((2, fy.shape[0]), np.float32)
+    quarter = np.float32(0.25)
+    for i in range(r0, r1):
+        _shear_row(src, starts, fy, 2 * i, rows[0])
+        _shear_row(src, starts, fy, 2 * i + 1, rows[1])
+        a = rows[0]
+        b = rows[1]
+        oi = out[i]
+        for j in range(out.shape[1]):
+            oi[j] = quarter * ((a[2 * j] + a[2 * j + 1]) + (b[2 * j] + b[2 * j + 1]))
+
+
+def _percentile(a: NDArray, q: float) -> float:
+    """``np.percentile(a, q)`` (linear method) of a float32 array, from one partition
+    (the next order statistic is the least value above it): the same number."""
+    flat = a.ravel()
+    n = flat.size
+    v = (n - 1) * (q / 100.0)
+    lo = math.floor(v)
+    t = v - lo
+    part = np.partition(flat, lo)
+    x = part[lo]
+    y = part[lo + 1 :].min() if lo + 1 < n else x
+    d = y - x
+    if t >= 0.5:
+        return float(y - d * np.float32(1.0 - t))
+    return float(x + d * np.float32(t))
 
 
 def _threads() -> int:
@@ -414,22 +535,68 @@ def _pool() -> ThreadPoolExecutor:
     return ThreadPoolExecutor(max_workers=_threads(), thread_name_prefix="seawatch-detect")
 
 
-def _run_rows(kernel: Callable[..., None], rows: int, first: NDArray, *args: Any) -> None:
-    """Run a row-range kernel ``kernel(first, *prefix, r0, r1, *rest)`` over ``rows`` rows,
-    in bands on a thread pool (the kernels release the GIL) when the image is large."""
-    n_prefix = 2
-    pre, rest = args[:n_prefix], args[n_prefix:]
-    bands = max(1, min(_threads(), rows // 96))
-    edges = np.linspace(0, rows, bands + 1).astype(int)
-    if bands == 1:
-        kernel(first, *pre, 0, rows, *rest)
+def _run_rows(
+    kernel: Callable[..., None], rows: int, head: tuple[Any, ...], tail: tuple[Any, ...]
+) -> None:
+    """Run a row-range kernel ``kernel(*head, r0, r1, *tail)`` over ``rows`` rows.
+
+    A large image is cut into a few bands per core that the calling thread and the pool's
+    threads take in turn (the kernels release the GIL): on a busy machine a thread that
+    loses its core holds up one small band, not half of the image.
+    """
+    workers = _threads()
+    bands = max(1, min(4 * workers, rows // 48))
+    if bands == 1 or workers == 1:
+        kernel(*head, 0, rows, *tail)
         return
-    jobs = [
-        _pool().submit(kernel, first, *pre, int(a), int(b), *rest)
-        for a, b in itertools.pairwise(edges)
-    ]
+    edges = np.linspace(0, rows, bands + 1).astype(int).tolist()
+    ticket = itertools.count()  # next() is atomic under the GIL
+
+    def work() -> None:
+        while (i := next(ticket)) < bands:
+            kernel(*head, edges[i], edges[i + 1], *tail)
+
+    jobs = [_pool().submit(work) for _ in range(min(workers, bands) - 1)]
+    work()
     for j in jobs:
         j.result()
+
+
+@njit(cache=True, nogil=True)
+def _gather_cells(a, step, sh, sw, ny, nx, reflect, out):  # pragma: no cover - compiled
+    """``|a|`` on the ``step``-subsampled grid ``a[::step, ::step]``, gathered into cells:
+    ``out[cy, cx]`` holds the ``sh × sw`` samples of cell (cy, cx); cells past the grid's
+    end are padded by reflection without repeating the edge, or by the edge value."""
+    hv = (a.shape[0] + step - 1) // step
+    wv = (a.shape[1] + step - 1) // step
+    for cy in range(ny):
+        for i in range(sh):
+            r = cy * sh + i
+            if r >= hv:
+                r = 2 * hv - 2 - r if reflect else hv - 1
+            row = a[r * step]
+            for cx in range(nx):
+                o = out[cy, cx]
+                n = i * sw
+                for j in range(sw):
+                    c = cx * sw + j
+                    if c >= wv:
+                        c = 2 * wv - 2 - c if reflect else wv - 1
+                    o[n + j] = abs(row[c * step])
+
+
+@njit(cache=True, nogil=True)
+def _median3_rows(q):  # pragma: no cover - compiled
+    """The median of each value and its two horizontal neighbours (edges repeated)."""
+    ny, nx = q.shape
+    out = np.empty_like(q)
+    for cy in range(ny):
+        for cx in range(nx):
+            x0 = q[cy, max(cx - 1, 0)]
+            x1 = q[cy, cx]
+            x2 = q[cy, min(cx + 1, nx - 1)]
+            out[cy, cx] = max(min(x0, x1), min(max(x0, x1), x2))
+    return out
 
 
 def _cell_grid(
@@ -443,19 +610,16 @@ def _cell_grid(
     h, w = a.shape
     ch = max(step, min(cell_h, h) // step * step)
     cw = max(step, min(cell_w, w) // step * step)
-    v = np.abs(a[::step, ::step])
+    hv, wv = -(-h // step), -(-w // step)  # the subsampled grid's shape
     sh, sw = ch // step, cw // step
-    ny, nx = -(-v.shape[0] // sh), -(-v.shape[1] // sw)
-    pad = ((0, ny * sh - v.shape[0]), (0, nx * sw - v.shape[1]))
-    if pad[0][1] or pad[1][1]:
-        v = np.pad(v, pad, mode="reflect" if min(v.shape) > max(sh, sw) else "edge")
-    cells = v.reshape(ny, sh, nx, sw).transpose(0, 2, 1, 3).reshape(ny, nx, sh * sw)
-    k = int(quantile * (cells.shape[2] - 1))
+    ny, nx = -(-hv // sh), -(-wv // sw)
+    cells = np.empty((ny, nx, sh * sw), np.float32)
+    _gather_cells(a, step, sh, sw, ny, nx, min(hv, wv) > max(sh, sw), cells)
+    k = int(quantile * (sh * sw - 1))
     q = np.partition(cells, k, axis=2)[:, :, k] * np.float32(1.0 / _ndtri(0.5 + 0.5 * quantile))
     if nx >= 3:
-        p = np.pad(q, ((0, 0), (1, 1)), mode="edge")
-        q = np.median(np.stack([p[:, :-2], p[:, 1:-1], p[:, 2:]]), axis=0)
-    return q.astype(np.float32), ch, cw
+        q = _median3_rows(q)
+    return q, ch, cw
 
 
 def _upsample(q: NDArray, shape: tuple[int, int], ch: int, cw: int, floor: float) -> NDArray:
@@ -534,7 +698,8 @@ class _Frame:
     point ``((c + 0.5) sx − 0.5, (wtop + r + off[c] + 0.5) sy − 0.5)`` (``off`` = the
     horizon shear [working px], None = 0)."""
 
-    full: NDArray  # the full-resolution grey frame
+    shape: tuple[int, int]  # the frame's (H, W) [px]
+    grey: NDArray | None  # the full-resolution grey frame (None: from ``colour``)
     band: NDArray  # float32 working band
     wtop: int
     sx: float
@@ -543,6 +708,15 @@ class _Frame:
     hrow: float  # the horizon's (or sea top's) row in the band [working px]; 0 if unknown
     colour: NDArray | None = None  # the full-resolution BGR frame
     chroma: list[tuple[int, NDArray]] | None = None  # (YCrCb channel, half-resolution band)
+
+    def grey_crop(self, y0: int, y1: int, x0: int, x1: int) -> NDArray:
+        """Rows ``y0 … y1 − 1``, columns ``x0 … x1 − 1`` of the full-resolution grey frame
+        (float32; converted from the colour frame on demand)."""
+        if self.grey is not None:
+            return self.grey[y0:y1, x0:x1].astype(np.float32)
+        assert self.colour is not None
+        crop = np.ascontiguousarray(self.colour[y0:y1, x0:x1])
+        return cv2.cvtColor(crop, cv2.COLOR_BGR2GRAY).astype(np.float32)
 
     def box_to_work(self, box: NDArray) -> tuple[float, float, float, float]:
         """Inclusive band-pixel box → unsheared working-pixel box (x0, y0, x1, y1)."""
@@ -748,15 +922,15 @@ class ClassicalShipDetector:
         Raises:
             ValueError: naming ``image``, ``sea_mask`` or ``horizon`` for bad input.
         """
-        full, quantum, colour = _gray(image)
-        if not self.colour:
-            colour = None
-        H, W = full.shape
+        grey, quantum, colour = _image_planes(image)
+        if colour is not None and not self.colour:
+            grey, colour = cv2.cvtColor(colour, cv2.COLOR_BGR2GRAY), None
+        H, W = (grey if grey is not None else colour).shape[:2]  # type: ignore[union-attr]
         mask = _sea_mask(sea_mask, (H, W))
         ends = _horizon_ends(horizon, W)
         if mask is not None and not mask.any():
             return Detections.empty()
-        fr = self._frame(full, colour, mask, ends, quantum)
+        fr = self._frame(grey, colour, mask, ends, quantum)
         if fr is None:
             return Detections.empty()
         band = fr.band
@@ -797,7 +971,7 @@ class ClassicalShipDetector:
 
     def _frame(
         self,
-        full: NDArray,
+        grey: NDArray | None,
         colour: NDArray | None,
         mask: NDArray[np.bool_] | None,
         ends: tuple[float, float] | None,
@@ -806,16 +980,11 @@ class ClassicalShipDetector:
         """The working band: the frame area-downscaled to ``work_height`` rows, sheared so
         that the horizon is one row (horizon-stabilised coordinates), cut from ``max_above``
         above the sea's top to the bottom (and the chroma planes Cr, Cb of a colour frame,
-        alike). None when no sea is in view."""
-        H, W = full.shape
+        alike). None when no sea is in view. ``grey`` may be None for a colour frame."""
+        H, W = (grey if grey is not None else colour).shape[:2]  # type: ignore[union-attr]
         s = min(1.0, self.work_height / H)
         wh, ww = max(8, round(H * s)), max(8, round(W * s))
         sy, sx = H / wh, W / ww  # full-frame pixels per working pixel
-        planes = [full if (wh, ww) == (H, W) else cv2.resize(full, (ww, wh), cv2.INTER_AREA)]
-        if colour is not None:
-            c = colour if (wh, ww) == (H, W) else cv2.resize(colour, (ww, wh), cv2.INTER_AREA)
-            ycc = cv2.cvtColor(c, cv2.COLOR_BGR2YCrCb)
-            planes += [ycc[:, :, 1], ycc[:, :, 2]]
         off = None
         if mask is not None:
             top = float(np.flatnonzero(mask.any(axis=1))[0] + 0.5) / sy - 0.5
@@ -827,37 +996,63 @@ class ClassicalShipDetector:
             top = float(y_w.mean())
             if float(np.ptp(y_w)) >= 0.5:
                 off = (y_w - top).astype(np.float32)
-                map_x = np.ascontiguousarray(
-                    np.broadcast_to(np.arange(ww, dtype=np.float32), (wh, ww))
-                )
-                map_y = np.arange(wh, dtype=np.float32)[:, None] + off[None, :]
-                planes = [
-                    cv2.remap(
-                        np.ascontiguousarray(p),
-                        map_x,
-                        map_y,
-                        cv2.INTER_LINEAR,
-                        borderMode=cv2.BORDER_REPLICATE,
-                    )
-                    for p in planes
-                ]
         else:
             top = 0.0
         if top >= wh - 1:
             return None
         wtop = int(min(wh - 8, max(0, math.floor(top - self.max_above * wh))))
-        band = planes[0][wtop:].astype(np.float32)
+        area = {"interpolation": cv2.INTER_AREA}
+        same = (wh, ww) == (H, W)
+        cwork = None
+        if colour is not None:
+            cwork = colour if same else cv2.resize(colour, (ww, wh), **area)
+        if grey is not None:
+            work = grey if same else cv2.resize(grey, (ww, wh), **area)
+        else:  # the luma of the area mean is the area mean of the luma
+            work = cv2.cvtColor(cwork, cv2.COLOR_BGR2GRAY)
+        if off is None:
+            band = work[wtop:].astype(np.float32)
+        else:  # working row r of column c is read at r + off[c]: the horizon is one row
+            band = self._shear(work, wtop + off, wh - wtop, "band")
         chroma = []
-        for ch_index, p in enumerate(planes[1:], start=1):
-            pb = p[wtop:]
-            lo_c, hi_c = cv2.minMaxLoc(np.ascontiguousarray(pb[::4, ::4]))[:2]
-            if hi_c - lo_c < 2.0 * max(quantum, 1e-6 * max(abs(hi_c), 1.0)):
-                continue  # a flat chroma plane (a grey frame stored as colour)
-            hc, wc = pb.shape[0] // 2, pb.shape[1] // 2
-            half = cv2.resize(pb[: 2 * hc, : 2 * wc], (wc, hc), interpolation=cv2.INTER_AREA)
-            chroma.append((ch_index, half.astype(np.float32)))
+        if cwork is not None and ww >= 2 and wh - wtop >= 2:
+            # Cr, Cb of the working frame, sheared like the band, at half its resolution:
+            # half-band pixel (i, j) is the mean of band rows 2i, 2i + 1, columns 2j, 2j + 1
+            ycc = cv2.cvtColor(cwork, cv2.COLOR_BGR2YCrCb)
+            shift = np.full(ww, wtop, np.float32) if off is None else wtop + off
+            for ch_index in (1, 2):
+                p = cv2.extractChannel(ycc, ch_index)  # contiguous rows shear faster
+                half = self._shear(p, shift, wh - wtop, f"chroma{ch_index}", half=True)
+                lo_c, hi_c = cv2.minMaxLoc(np.ascontiguousarray(half[::2, ::2]))[:2]
+                if hi_c - lo_c < 2.0 * max(quantum, 1e-6 * max(abs(hi_c), 1.0)):
+                    continue  # a flat chroma plane (a grey frame stored as colour)
+                chroma.append((ch_index, half))
         hrow = top - wtop if ends is not None or mask is not None else 0.0
-        return _Frame(full, band, wtop, sx, sy, off, hrow, colour, chroma)
+        return _Frame((H, W), grey, band, wtop, sx, sy, off, hrow, colour, chroma)
+
+    def _shear(
+        self, src: NDArray, shift: NDArray, rows: int, name: str, half: bool = False
+    ) -> NDArray:
+        """``rows`` rows of ``src`` (float32), column ``c`` read from row ``i + shift[c]``
+        (linear between rows, edge rows repeated): a per-column vertical shift [px].
+        ``half``: the result's 2 × 2 means instead (``rows // 2`` rows, half the
+        columns)."""
+        shift = np.asarray(shift, dtype=np.float32)
+        iy = np.floor(shift).astype(np.int64)
+        fy = shift - iy.astype(np.float32)
+        cut = np.flatnonzero(np.diff(iy)) + 1  # runs of columns with one whole shift
+        starts = np.empty((cut.size + 2, 2), np.int64)
+        starts[0] = 0, iy[0]
+        starts[1:-1, 0] = cut
+        starts[1:-1, 1] = iy[cut]
+        starts[-1] = shift.size, 0
+        if half:
+            out = self._buffer(f"shear-{name}", (rows // 2, shift.size // 2))
+            _run_rows(_shear_half_kernel, rows // 2, (src, starts, fy), (out,))
+        else:
+            out = self._buffer(f"shear-{name}", (rows, shift.size))
+            _run_rows(_shear_kernel, rows, (src, starts, fy), (out,))
+        return out
 
     # ------------------------------------------------------------------ steps
     def _levels(self, band: NDArray, floor: float, fr: _Frame) -> list[_Level]:
@@ -900,14 +1095,9 @@ class ClassicalShipDetector:
         gs = cv2.GaussianBlur(
             g, (3, 3), 0.8, dst=self._buffer(f"g{tag}", shape), borderType=cv2.BORDER_REPLICATE
         )
-        e2 = cv2.blur(gs, (5, 5), dst=self._buffer(f"b{tag}", shape))
-        np.subtract(gs, e2, out=e2)
-        np.multiply(e2, e2, out=e2)
-        box = {"normalize": False, "borderType": cv2.BORDER_REPLICATE}
-        v3 = cv2.boxFilter(gs, -1, (1, 3), dst=self._buffer(f"v{tag}", shape), **box)
-        q3 = cv2.boxFilter(e2, -1, (1, 3), dst=self._buffer(f"q{tag}", shape), **box)
+        b5 = cv2.blur(gs, (5, 5), dst=self._buffer(f"b{tag}", shape))
         hi, lo, d, c, tex = (self._buffer(f"{n}{tag}", shape) for n in ("hi", "lo", "d", "c", "t"))
-        _run_rows(_contrast_kernel, shape[0], gs, v3, q3, guard, flank, pol, hi, lo, d, c, tex)
+        _run_rows(_contrast_kernel, shape[0], (gs, b5), (guard, flank, pol, hi, lo, d, c, tex))
         if factor == 1:
             base = _cell_noise(d, self.cell[0], self.cell[1], floor, step=2)
         else:  # coarser scales: cells of a quarter of the width, every pixel
@@ -1025,16 +1215,18 @@ class ClassicalShipDetector:
             f = lv.factor
             b = -(-self.border // f)
             hz, wz = z.shape
-            inner = z[: max(0, hz - b), b : max(b, wz - b)]
-            rr, cc = np.nonzero(inner > self.threshold)
-            if rr.size == 0:
-                continue
-            seeds = rr.astype(np.int64) * wz + (cc + b)
             visited = self._work(f"visited{f}", hz * wz, np.uint8, zero=True)
             queue = self._work(f"queue{f}", hz * wz, np.int64)
             boxes, peaks, _ = _grow_kernel(
-                z, seeds, np.float32(self.grow_threshold), visited, queue
+                z,
+                np.float32(self.threshold),
+                b,
+                np.float32(self.grow_threshold),
+                visited,
+                queue,
             )
+            if boxes.shape[0] == 0:
+                continue
             w = (boxes[:, 2] - boxes[:, 0] + 1) * f
             h = (boxes[:, 3] - boxes[:, 1] + 1) * f
             ok = (w <= max_w + f) & (h <= max_h + f) & (w <= wide * h + f) & (h <= tall * w + f)
@@ -1089,7 +1281,7 @@ class ClassicalShipDetector:
         h = (y1 - y0 + 1) * fr.sy
         u = 0.5 * (x0 + x1 + 1) * fr.sx - 0.5
         v = (y1 + 1) * fr.sy - 0.5
-        return _in_sea(u, v, mask, ends, fr.full.shape, tol + 2 * h)
+        return _in_sea(u, v, mask, ends, fr.shape, tol + 2 * h)
 
     def _resolve_scales(self, cands: list[_Candidate]) -> list[_Candidate]:
         """Coarse-to-fine arbitration: a coarse candidate narrow enough for the next finer
@@ -1145,8 +1337,8 @@ class ClassicalShipDetector:
     ) -> tuple[float, float, float, float, float, float, float] | None:
         """Full-resolution object mask inside a candidate: box (x, y, w, h), water-line
         point (u, v) [px] and object area [px²]; None when nothing stands out."""
-        full, sx, sy = fr.full, fr.sx, fr.sy
-        H, W = full.shape
+        sx, sy = fr.sx, fr.sy
+        H, W = fr.shape
         bx0, by0, bx1, by1 = fr.box_to_work(c.box)  # unsheared working pixels
         m = max(2.0, 0.25 * (by1 - by0 + 1)) + lv.factor
         # crop in full-frame pixels (the candidate plus a margin)
@@ -1169,9 +1361,10 @@ class ClassicalShipDetector:
         lo = cv2.remap(lv.bg_dark, mx, my, **remap)
         # the crop itself, smoothed like the working image (one pixel of context)
         gx0, gy0 = max(0, fx0 - 1), max(0, fy0 - 1)
-        g = full[gy0 : min(H, fy1 + 1), gx0 : min(W, fx1 + 1)].astype(np.float32)
-        g = cv2.GaussianBlur(g, (3, 3), 0.8, borderType=cv2.BORDER_REPLICATE)
-        g = g[fy0 - gy0 : fy0 - gy0 + fy1 - fy0, fx0 - gx0 : fx0 - gx0 + fx1 - fx0]
+        gx1, gy1 = min(W, fx1 + 1), min(H, fy1 + 1)
+        inner = (slice(fy0 - gy0, fy0 - gy0 + fy1 - fy0), slice(fx0 - gx0, fx0 - gx0 + fx1 - fx0))
+        g = fr.grey_crop(gy0, gy1, gx0, gx1)
+        g = cv2.GaussianBlur(g, (3, 3), 0.8, borderType=cv2.BORDER_REPLICATE)[inner]
         if self.polarity == "bright":
             res = g - hi
         elif self.polarity == "dark":
@@ -1180,10 +1373,9 @@ class ClassicalShipDetector:
             res = np.maximum(g - hi, lo - g)
         res /= cv2.remap(lv.sigma, mx, my, **remap)  # in noise units, like z
         if lv.chroma and fr.colour is not None:
-            col = fr.colour[gy0 : min(H, fy1 + 1), gx0 : min(W, fx1 + 1)]
-            ycc = cv2.cvtColor(np.ascontiguousarray(col), cv2.COLOR_BGR2YCrCb).astype(np.float32)
-            ycc = cv2.GaussianBlur(ycc, (3, 3), 0.8, borderType=cv2.BORDER_REPLICATE)
-            ycc = ycc[fy0 - gy0 : fy0 - gy0 + fy1 - fy0, fx0 - gx0 : fx0 - gx0 + fx1 - fx0]
+            col = np.ascontiguousarray(fr.colour[gy0:gy1, gx0:gx1])
+            ycc = cv2.cvtColor(col, cv2.COLOR_BGR2YCrCb).astype(np.float32)
+            ycc = cv2.GaussianBlur(ycc, (3, 3), 0.8, borderType=cv2.BORDER_REPLICATE)[inner]
             cx, cy = (mx + 0.5) / 2 - 0.5, (my + 0.5) / 2 - 0.5  # half-resolution planes
             for ch_index, hc, lc, sc in lv.chroma:
                 gc = ycc[:, :, ch_index]
@@ -1199,16 +1391,17 @@ class ClassicalShipDetector:
         core = res[cy0:cy1, cx0:cx1]
         if core.size == 0:
             return None
-        peak = float(np.percentile(core, 95)) if core.size >= 20 else float(core.max())
+        peak = _percentile(core, 95.0) if core.size >= 20 else float(core.max())
         if peak <= 0:
             return None
         obj = (res > 0.4 * peak).view(np.uint8)
         n, labels = cv2.connectedComponents(obj, connectivity=8)
-        touching = np.unique(labels[cy0:cy1, cx0:cx1])
-        touching = touching[touching > 0]
-        if touching.size == 0:
+        touching = np.zeros(n, dtype=bool)
+        touching[labels[cy0:cy1, cx0:cx1].ravel()] = True
+        touching[0] = False
+        if not touching.any():
             return None
-        sel = np.isin(labels, touching) if n > 2 else labels > 0
+        sel = touching[labels] if n > 2 else labels > 0
         rr, cc = np.nonzero(sel)
         r0, r1, c0, c1 = int(rr.min()), int(rr.max()), int(cc.min()), int(cc.max())
         x, y = fx0 + c0 - 0.5, fy0 + r0 - 0.5

@@ -279,9 +279,13 @@ def _hough(P: np.ndarray, xs: np.ndarray, xc: float, slopes: np.ndarray, m: floa
             # rows c with 0 <= c + off <= h - 1; padded V covers the two border rows
             c0 = max(0, -r - 1)
             c1 = min(h, h - r)
+            if c1 <= c0:
+                continue
             for k in range(2):
-                for c in range(c0, c1):
-                    out[k, i, c] += g * V[k, s, c + r + 1] + f * V[k, s, c + r + 2]
+                src = V[k, s, c0 + r + 1 : c1 + r + 2]  # rows c0 + r + 1 …, as views so
+                dst = out[k, i, c0:c1]  # that the loop runs on contiguous memory
+                for m in range(c1 - c0):
+                    dst[m] += g * src[m] + f * src[m + 1]
     out *= np.float32(1.0 / n_strips)
     return out
 
@@ -518,6 +522,25 @@ def _as_image(image: ArrayLike) -> np.ndarray:
     return np.ascontiguousarray(arr)
 
 
+def _percentiles(a: np.ndarray, qs: tuple[float, ...], axis: int | None = None) -> np.ndarray:
+    """``np.percentile(a, qs, axis=axis)`` (linear interpolation; ``axis`` None, or 0 of a
+    2-D array) from one sort (numpy's vectorised sort beats a partition at several
+    ranks), without numpy's general-purpose overhead: the same numbers."""
+    a = np.asarray(a)
+    # the sample runs along the last axis of a C-contiguous (columns, n) array
+    b = a.reshape(1, -1) if axis is None else np.ascontiguousarray(a.T)
+    n = b.shape[1]
+    v = (n - 1) * (np.asarray(qs, dtype=np.float64) / 100.0)
+    lo = np.floor(v).astype(np.intp)
+    hi = np.minimum(lo + 1, n - 1)
+    t = (v - lo)[:, None]
+    part = np.sort(b, axis=1)
+    x, y = part[:, lo].T, part[:, hi].T
+    d = y - x
+    out = np.where(t >= 0.5, y - d * (1 - t), x + d * t)
+    return out[:, 0] if axis is None else out
+
+
 def _prepare(arr: np.ndarray, work_width: int) -> tuple[np.ndarray, np.ndarray, float, float]:
     """(luma, colour, sx, sy): working-resolution luma (h, w) and colour (h, w, C) float32,
     both normalised so that the luma's 1st–99th percentiles map to 0–1, and the scale
@@ -533,7 +556,7 @@ def _prepare(arr: np.ndarray, work_width: int) -> tuple[np.ndarray, np.ndarray, 
     else:
         small = cv2.resize(arr, (w, h), interpolation=cv2.INTER_AREA).astype(np.float32)
     luma = cv2.cvtColor(small, cv2.COLOR_BGR2GRAY) if small.ndim == 3 else small
-    lo, hi = np.percentile(luma[::2, ::2], (1.0, 99.0))
+    lo, hi = _percentiles(luma[::2, ::2], (1.0, 99.0))
     spread = float(hi - lo)
     scale = np.float32(1.0 / spread if spread > 0 else 0.0)
     luma = (luma - np.float32(lo)) * scale
@@ -702,7 +725,7 @@ def _strip_features(
     col = cv2.resize(colour, (n_strips, h), interpolation=cv2.INTER_AREA).reshape(h, n_strips, -1)
     tx = cv2.resize(tex, (n_strips, h), interpolation=cv2.INTER_AREA).reshape(h, n_strips, 1)
     F = np.concatenate([col, tx], axis=2)
-    q1, q9 = np.percentile(F.reshape(-1, F.shape[2]), (10.0, 90.0), axis=0)
+    q1, q9 = _percentiles(F.reshape(-1, F.shape[2]), (10.0, 90.0), axis=0)
     F = F / np.maximum(q9 - q1, 1e-3)
     cum = np.zeros((h + 1, n_strips, F.shape[2]), dtype=np.float64)
     np.cumsum(F, axis=0, out=cum[1:])
@@ -874,8 +897,11 @@ class HorizonTracker:
             self.last_nis = 0.0
             return self._estimate(True, detection.confidence)
         dt = self._dt(time)
-        F, Q = constant_velocity(2, dt, sa)
-        self._kf.predict(F=F, Q=Q)
+        if abs(dt * self.fps - 1.0) < 1e-6:
+            self._kf.predict()  # one frame interval: the filter's own model
+        else:
+            F, Q = constant_velocity(2, dt, sa)
+            self._kf.predict(F=F, Q=Q)
         self._time = None if time is None else float(time)
         accepted = False
         self.last_nis = math.nan
