@@ -18,7 +18,7 @@ report (:mod:`seawatch.report.html`) uses too.
 Positions: a row's ``lat``/``lon`` columns; where those are empty but ``north_m``/``east_m``
 are known and the camera's geodetic position is given, the position is mapped from the
 tangent plane at the camera (:func:`seawatch.geometry.geodesy.north_east_to_geodetic`, as
-:func:`seawatch.pipeline.geo_reference` does). Rows with no position are skipped. Without
+:mod:`seawatch.pipeline` does). Rows with no position are skipped. Without
 any geodetic position (no ``lat``/``lon`` in the table and no camera position) there is no
 GeoJSON: :func:`tracks_to_geojson` returns None and warns.
 """
