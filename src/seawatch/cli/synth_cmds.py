@@ -24,6 +24,7 @@ from seawatch.cli._common import (
     progress_bar,
     warnings_to_stderr,
 )
+from seawatch.io.nav import parse_time
 
 __all__ = ["ais", "app", "ship_video"]
 
@@ -113,30 +114,6 @@ def ship_video(
             typer.echo(f"wrote {path}")
 
 
-def _parse_start(text: str) -> float:
-    """``--start``: ISO 8601 (naive = UTC) or seconds since the epoch → epoch seconds."""
-    s = text.strip()
-    try:
-        v = float(s)
-    except ValueError:
-        pass
-    else:
-        if not math.isfinite(v):
-            raise BadInput(f"--start: expected a time, got {text!r}")
-        return v
-    iso = s[:-1] + "+00:00" if s.endswith(("Z", "z")) else s
-    try:
-        dt = datetime.fromisoformat(iso)
-    except ValueError:
-        raise BadInput(
-            f"--start: expected an ISO 8601 UTC time (e.g. 2016-01-12T13:23:14Z) or seconds "
-            f"since the epoch, got {text!r}"
-        ) from None
-    if dt.tzinfo is None:
-        dt = dt.replace(tzinfo=UTC)
-    return dt.timestamp()
-
-
 @app.command("ais")
 def ais(
     ais_file: Annotated[
@@ -209,7 +186,10 @@ def ais(
             raise BadInput(f"--duration: expected a positive number of seconds, got {duration}")
         if fps is not None and not (math.isfinite(fps) and fps > 0.0):
             raise BadInput(f"--fps: expected a positive frame rate, got {fps}")
-        t0 = None if start is None else _parse_start(start)
+        try:
+            t0 = None if start is None else parse_time(start, "--start")
+        except ValueError as exc:
+            raise BadInput(str(exc)) from None
         if ais_file is None:
             from seawatch.scenarios.solent_ais import default_ais_path
 
