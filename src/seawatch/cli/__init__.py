@@ -297,6 +297,67 @@ def bench(
             raise typer.Exit(EXIT_FAILED)
 
 
+@app.command()
+def batch(
+    sources: Annotated[list[str], typer.Argument(help="Videos, image folders or stream URLs.")],
+    camera: Annotated[
+        Path | None, typer.Option(help="Camera file of the recordings (seawatch/OpenCV YAML).")
+    ] = None,
+    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("out/batch"),
+    estimator: Annotated[str, typer.Option(help="ekf, ukf, diffuse-rls or geometry.")] = "ekf",
+    attitude: Annotated[str, typer.Option(help="auto, horizon or file.")] = "auto",
+    video: Annotated[bool, typer.Option(help="Write annotated.mp4 per recording.")] = True,
+    report: Annotated[bool, typer.Option(help="Write report.html per recording.")] = True,
+    workers: Annotated[
+        int | None,
+        typer.Option(help="Local Dask worker processes (default: the cores; 1: no Dask).", min=1),
+    ] = None,
+    scheduler: Annotated[
+        str | None, typer.Option(help="Existing Dask scheduler, e.g. tcp://HOST:8786.")
+    ] = None,
+    json_out: Annotated[bool, typer.Option("--json", help="Print the batch JSON.")] = False,
+) -> None:
+    """Track many recordings, one Dask task each: OUT/<name>/ holds what [bold]seawatch
+    track[/] writes for each, OUT/batch.json every recording's summary or error (rewritten
+    as each ends). A failing recording is reported and the others go on (exit 1 if any
+    failed).
+
+    Example: [cyan]seawatch batch day1/*.mp4 --camera mast.yaml --out out/day1 --workers 2[/]
+    """
+    from seawatch.batch import track_batch
+
+    with exit_codes(), warnings_to_stderr():
+        if estimator not in ("ekf", "ukf", "diffuse-rls", "geometry"):
+            raise BadInput(
+                f"--estimator: expected ekf, ukf, diffuse-rls or geometry, got {estimator!r}"
+            )
+        if attitude not in ("auto", "horizon", "file"):
+            raise BadInput(f"--attitude: expected auto, horizon or file, got {attitude!r}")
+        with progress_bar() as bar:
+            task = bar.add_task("batch", total=len(sources))
+            result = track_batch(
+                sources,
+                out,
+                camera=camera,
+                workers=workers,
+                scheduler=scheduler,
+                estimator=estimator,
+                attitude=attitude,
+                annotate=video,
+                report=report,
+                progress=lambda done, total: bar.update(task, completed=done, total=total),
+            )
+        if json_out:
+            emit_json(result.to_json())
+        else:
+            for item in result.items:
+                state = "ok" if item.ok else f"FAILED: {item.error}"
+                typer.echo(f"{item.source} -> {item.out_dir} ({state})")
+            typer.echo(f"wrote {result.summary_path}")
+        if result.failed:
+            raise typer.Exit(EXIT_FAILED)
+
+
 app.command()(geometry_cmds.locate)
 app.command()(geometry_cmds.stereo)
 app.command()(geometry_cmds.calibrate)

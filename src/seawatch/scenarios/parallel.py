@@ -79,6 +79,7 @@ __all__ = [
     "SchedulerError",
     "SweepPoint",
     "SweepResult",
+    "dask_client",
     "default_workers",
     "parse_params",
     "plan_chunks",
@@ -307,6 +308,22 @@ def _remote_client(scheduler: Any, timeout: float) -> Iterator[Any]:
         yield client
     finally:
         client.close()
+
+
+@contextlib.contextmanager
+def dask_client(
+    workers: int | None = None, scheduler: Any = None, timeout: float = DEFAULT_TIMEOUT_S
+) -> Iterator[Any]:
+    """A Dask client: of the scheduler at ``scheduler`` (SchedulerError within ``timeout``
+    seconds if it does not answer or has no worker), else of a local cluster of
+    ``workers`` single-threaded processes (default: the machine's cores)."""
+    if scheduler is not None:
+        with _remote_client(scheduler, timeout) as client:
+            yield client
+    else:
+        n = default_workers() if workers is None else _positive_int("workers", workers)
+        with _local_client(n) as client:
+            yield client
 
 
 def _client_workers(client: Any) -> int:
