@@ -1,0 +1,56 @@
+"""TableWriter: rows written per flush in one piece, cells formatted, Parquet optional."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+
+import numpy as np
+import pytest
+
+from seawatch.io.track_table import TableWriter, read_table
+
+
+def test_rows_appear_only_at_flush_and_cells_round_trip(tmp_path):
+    path = tmp_path / "t.csv"
+    w = TableWriter(path, ("a", "b", "c", "d"))
+    assert path.read_bytes() == b"a,b,c,d\r\n"  # the header is on disk at once
+    w.write({"a": np.int64(3), "b": 50.79031234567, "c": math.nan, "e": "ignored"})
+    w.write({"a": 4, "b": -1.5e-9, "c": None, "d": "x,y"})
+    assert path.read_bytes() == b"a,b,c,d\r\n"  # nothing before the flush
+    w.flush()
+    rows = read_table(path)
+    assert rows == [
+        {"a": "3", "b": "50.79031235", "c": "", "d": ""},
+        {"a": "4", "b": "-1.5e-09", "c": "", "d": "x,y"},
+    ]
+    assert w.close() == [path] and w.rows == 2
+
+
+def test_bad_tables_name_the_file(tmp_path):
+    with pytest.raises(ValueError, match="no such file"):
+        read_table(tmp_path / "none.csv")
+    empty = tmp_path / "empty.csv"
+    empty.write_text("")
+    with pytest.raises(ValueError, match=r"empty\.csv"):
+        read_table(empty)
+    with pytest.raises(ValueError, match="cannot write"):
+        TableWriter(tmp_path / "no" / "such" / "t.csv", ("a",))
+
+
+@pytest.mark.skipif(importlib.util.find_spec("pyarrow") is not None, reason="pyarrow installed")
+def test_parquet_without_pyarrow_is_a_clear_error(tmp_path):
+    with pytest.raises(ValueError, match=r"--parquet: needs pyarrow.*seawatch\[parquet\]"):
+        TableWriter(tmp_path / "t.csv", ("a",), parquet=True)
+
+
+@pytest.mark.skipif(importlib.util.find_spec("pyarrow") is None, reason="pyarrow not installed")
+def test_parquet_copy_holds_the_csv_rows(tmp_path):
+    import pyarrow.parquet as pq
+
+    w = TableWriter(tmp_path / "t.csv", ("a", "b"), parquet=True)
+    w.write({"a": 1, "b": 2.5})
+    w.flush()
+    out = w.close()
+    table = pq.read_table(out[1]).to_pydict()
+    assert table == {"a": [1], "b": [2.5]}
