@@ -226,27 +226,35 @@ def _table(
 # ==========================================================================================
 
 
-def _existing_file(path: str | os.PathLike[str]) -> Path:
+def _existing_file(path: str | os.PathLike[str], kind: str = "AIS") -> Path:
+    """``path`` as a Path; FileNotFoundError ("<kind> file not found") or ValueError."""
     p = Path(path)
     if not p.exists():
-        raise FileNotFoundError(f"AIS file not found: {p}")
+        raise FileNotFoundError(f"{kind} file not found: {p}")
     if not p.is_file():
         raise ValueError(f"path: {p} is not a file")
     return p
 
 
-def _warn_skipped(source: Path, skipped: Sequence[SkippedRow], total: int) -> None:
-    """One AisWarning per skipped row (the first MAX_WARNINGS), then a summary."""
+def _warn_skipped(
+    source: Path,
+    skipped: Sequence[SkippedRow],
+    total: int,
+    category: type[UserWarning] = AisWarning,
+    unit: str = "rows",
+) -> None:
+    """One warning of ``category`` per skipped row (the first MAX_WARNINGS), then a
+    summary over all ``total`` ``unit`` read (also used by :mod:`seawatch.io.nav`)."""
     for s in skipped[:MAX_WARNINGS]:
         warnings.warn(
-            AisWarning(f"{source}, line {s.line}: {s.reason}: {s.detail}; skipped"), stacklevel=3
+            category(f"{source}, line {s.line}: {s.reason}: {s.detail}; skipped"), stacklevel=3
         )
     if len(skipped) > MAX_WARNINGS:
         reasons = Counter(s.reason for s in skipped)
         why = ", ".join(f"{n} {r}" for r, n in sorted(reasons.items()))
         warnings.warn(
-            AisWarning(
-                f"{source}: {len(skipped)} of {total} rows skipped in total ({why}); "
+            category(
+                f"{source}: {len(skipped)} of {total} {unit} skipped in total ({why}); "
                 f"{len(skipped) - MAX_WARNINGS} more not listed one by one"
             ),
             stacklevel=3,

@@ -76,7 +76,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from seawatch._validation import FloatArray, as_float_array, positive
 from seawatch.geometry.geodesy import geodetic_to_north_east, north_east_to_geodetic
-from seawatch.io.ais import SkippedRow
+from seawatch.io.ais import MAX_WARNINGS, SkippedRow, _existing_file, _warn_skipped
 
 __all__ = [
     "CSV_COLUMNS",
@@ -104,8 +104,6 @@ a few fixes is still bridged; a longer outage is unknown apart from the extrapol
 allowance at its ends)."""
 MIN_COURSE_SPEED = 0.5
 """Slowest speed [m/s] (about 1 kn) at which course over ground stands in for heading."""
-MAX_WARNINGS = 10
-"""Skipped lines warned about one by one; the rest are counted in one summary warning."""
 
 CSV_COLUMNS: Mapping[str, tuple[str, ...]] = {
     "time": ("time", "t", "time_s", "timestamp", "datetime", "utc"),
@@ -609,31 +607,6 @@ def _interp(
 # ==========================================================================================
 
 
-def _existing_file(path: str | os.PathLike[str]) -> Path:
-    p = Path(path)
-    if not p.exists():
-        raise FileNotFoundError(f"NAV file not found: {p}")
-    if not p.is_file():
-        raise ValueError(f"path: {p} is not a file")
-    return p
-
-
-def _warn_skipped(source: Path, skipped: Sequence[SkippedRow], total: int) -> None:
-    for s in skipped[:MAX_WARNINGS]:
-        warnings.warn(
-            NavWarning(f"{source}, line {s.line}: {s.reason}: {s.detail}; skipped"), stacklevel=3
-        )
-    if len(skipped) > MAX_WARNINGS:
-        why = ", ".join(f"{n} {r}" for r, n in sorted(Counter(s.reason for s in skipped).items()))
-        warnings.warn(
-            NavWarning(
-                f"{source}: {len(skipped)} of {total} lines skipped in total ({why}); "
-                f"{len(skipped) - MAX_WARNINGS} more not listed one by one"
-            ),
-            stacklevel=3,
-        )
-
-
 def _position_problem(lat: float, lon: float) -> str | None:
     if not (math.isfinite(lat) and math.isfinite(lon)):
         return "latitude/longitude not finite"
@@ -674,7 +647,7 @@ def _finish(
     skipped.sort(key=lambda s: s.line)
     pos_ok = np.isfinite(cols["a"]) & np.isfinite(cols["b"])
     if not np.any(pos_ok):
-        _warn_skipped(p, skipped, n_rows)
+        _warn_skipped(p, skipped, n_rows, NavWarning, "lines")
         raise ValueError(f"{p}: no usable position fix in {n_rows} rows")
     # heading from course over ground where no true heading is near (module docstring)
     heading = np.mod(cols["heading"], 2.0 * np.pi)
@@ -693,7 +666,7 @@ def _finish(
     from_course = ~has_hd & ~near & np.isfinite(course) & moving
     heading = np.where(from_course, course, heading)
     if not np.any(np.isfinite(heading)):
-        _warn_skipped(p, skipped, n_rows)
+        _warn_skipped(p, skipped, n_rows, NavWarning, "lines")
         raise ValueError(
             f"{p}: no heading: the file has no true heading (a heading column, HDT or "
             f"$PASHR) and no course over ground while making way (course/VTG/RMC at "
@@ -723,7 +696,7 @@ def _finish(
     counts.update(Counter(s.reason for s in skipped))
     counts.update(extra_counts or {})
     counts["heading_from_course"] = int(np.sum(from_course))
-    _warn_skipped(p, skipped, n_rows)
+    _warn_skipped(p, skipped, n_rows, NavWarning, "lines")
     return NavTrack(
         time=t,
         north=north,
@@ -809,7 +782,7 @@ def read_nav_csv(
         ValueError: no header with a time, a position and a heading or course column;
             no usable position; no heading at all (message names the file).
     """
-    p = _existing_file(path)
+    p = _existing_file(path, "NAV")
     rows: dict[str, list[float]] = {k: [] for k in _ROW_KEYS}
     skipped: list[SkippedRow] = []
     n_rows = 0
@@ -852,7 +825,7 @@ def read_nav_csv(
             for k in _ROW_KEYS:
                 rows[k].append(rec[k])
     if not rows["time"]:
-        _warn_skipped(p, skipped, n_rows)
+        _warn_skipped(p, skipped, n_rows, NavWarning, "lines")
         raise ValueError(f"{p}: no usable position fix in {n_rows} rows")
     return _finish(p, rows, skipped, n_rows, local=local, lat0=lat0, lon0=lon0)
 
@@ -958,7 +931,7 @@ def read_nav_nmea(
     """
     import pynmea2
 
-    p = _existing_file(path)
+    p = _existing_file(path, "NAV")
     first_date: float | None = None
     if date is not None:
         try:
@@ -1101,7 +1074,7 @@ def read_nav_nmea(
         for k in _ROW_KEYS[1:]:
             rows[k].append(rec.get(k, math.nan))
     if not rows["time"]:
-        _warn_skipped(p, skipped, n_sent)
+        _warn_skipped(p, skipped, n_sent, NavWarning, "lines")
         raise ValueError(f"{p}: no usable position fix in {n_sent} NMEA sentences")
     extra = {"fixes": n_fix, "headings": n_head, "ignored": n_ignored, "untimed": n_untimed}
     return _finish(p, rows, skipped, n_sent, local=False, lat0=lat0, lon0=lon0, extra_counts=extra)
@@ -1144,7 +1117,7 @@ def read_nav(
         FileNotFoundError: the file does not exist.
         ValueError: missing columns, no usable fix, no heading (message names the file).
     """
-    p = _existing_file(path)
+    p = _existing_file(path, "NAV")
     with p.open("rb") as fh:
         for raw in fh:
             text = raw.strip()
