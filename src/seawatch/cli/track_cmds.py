@@ -47,41 +47,31 @@ def _load_inputs(
     start: str | None,
 ) -> dict[str, Any]:
     """Read every input file before any work: bad input is exit 2 naming the option."""
+    from seawatch.io.ais import read_ais
     from seawatch.io.camera_file import load_camera
+    from seawatch.io.nav import parse_time, read_nav
 
-    out: dict[str, Any] = {"camera": None, "platform": None, "ais": None, "start": None}
-    if camera is not None:
+    def read(option: str, path: Path | None, reader: Any) -> Any:
+        if path is None:
+            return None
         try:
-            out["camera"] = load_camera(camera)
+            return reader(path)
         except FileNotFoundError:
-            raise BadInput(f"--camera {camera}: no such file") from None
+            raise BadInput(f"{option} {path}: no such file") from None
         except ValueError as exc:
-            raise BadInput(f"--camera: {exc}") from None
-    if platform is not None:
-        from seawatch.io.nav import read_nav
+            raise BadInput(f"{option}: {exc}") from None
 
-        try:
-            out["platform"] = read_nav(platform)
-        except FileNotFoundError:
-            raise BadInput(f"--platform {platform}: no such file") from None
-        except ValueError as exc:
-            raise BadInput(f"--platform: {exc}") from None
-    if ais is not None:
-        from seawatch.io.ais import read_ais
-
-        try:
-            out["ais"] = read_ais(ais)
-        except FileNotFoundError:
-            raise BadInput(f"--ais {ais}: no such file") from None
-        except ValueError as exc:
-            raise BadInput(f"--ais: {exc}") from None
-        if len(out["ais"]) == 0:
-            raise BadInput(f"--ais {ais}: no position report could be decoded")
+    out: dict[str, Any] = {
+        "camera": read("--camera", camera, load_camera),
+        "platform": read("--platform", platform, read_nav),
+        "ais": read("--ais", ais, read_ais),
+        "start": None,
+    }
+    if out["ais"] is not None and len(out["ais"]) == 0:
+        raise BadInput(f"--ais {ais}: no position report could be decoded")
     if truth is not None and not truth.is_file():
         raise BadInput(f"--truth {truth}: no such file")
     if start is not None:
-        from seawatch.io.nav import parse_time
-
         try:
             out["start"] = parse_time(start, "--start")
         except ValueError as exc:
