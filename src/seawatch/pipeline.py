@@ -58,6 +58,7 @@ __all__ = [
     "PIXEL_SIGMA",
     "TRACK_TABLE_COLUMNS",
     "TrackRun",
+    "check_options",
     "read_clip_start",
     "track_video",
 ]
@@ -342,6 +343,15 @@ def _prepare_out(out_dir: Path) -> Path:
     return out_dir
 
 
+def check_options(estimator: str, attitude: str) -> None:
+    """ValueError naming ``--estimator`` or ``--attitude`` when either is not one of the
+    choices of :func:`track_video` (the CLI checks before reading any input)."""
+    if estimator not in ESTIMATORS:
+        raise ValueError(f"--estimator: expected one of {', '.join(ESTIMATORS)}, got {estimator!r}")
+    if attitude not in ("auto", "horizon", "file"):
+        raise ValueError(f"--attitude: expected auto, horizon or file, got {attitude!r}")
+
+
 def track_video(
     source: str | Path,
     out_dir: str | Path,
@@ -404,10 +414,7 @@ def track_video(
         ValueError: bad input, naming it (also raised by the readers:
             :class:`seawatch.io.video.VideoError` for a missing or undecodable video).
     """
-    if estimator not in ESTIMATORS:
-        raise ValueError(f"--estimator: expected one of {', '.join(ESTIMATORS)}, got {estimator!r}")
-    if attitude not in ("auto", "horizon", "file"):
-        raise ValueError(f"--attitude: expected auto, horizon or file, got {attitude!r}")
+    check_options(estimator, attitude)
     out = _prepare_out(Path(out_dir))
     notes: list[str] = []
 

@@ -325,14 +325,10 @@ def batch(
     Example: [cyan]seawatch batch day1/*.mp4 --camera mast.yaml --out out/day1 --workers 2[/]
     """
     from seawatch.batch import track_batch
+    from seawatch.pipeline import check_options
 
     with exit_codes(), warnings_to_stderr():
-        if estimator not in ("ekf", "ukf", "diffuse-rls", "geometry"):
-            raise BadInput(
-                f"--estimator: expected ekf, ukf, diffuse-rls or geometry, got {estimator!r}"
-            )
-        if attitude not in ("auto", "horizon", "file"):
-            raise BadInput(f"--attitude: expected auto, horizon or file, got {attitude!r}")
+        check_options(estimator, attitude)
         with progress_bar() as bar:
             task = bar.add_task("batch", total=len(sources))
             result = track_batch(

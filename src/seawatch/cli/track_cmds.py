@@ -150,17 +150,12 @@ def track(
     Example: [cyan]seawatch synth ship-video --case medium --out clip && seawatch track
     clip/video.mp4 --camera clip/camera.yaml --truth clip/truth.csv --out out/track --json[/]
     """
-    from seawatch.pipeline import error_summary, track_video
+    from seawatch.pipeline import check_options, error_summary, track_video
 
     with exit_codes(), warnings_to_stderr():
         if filter not in ("afkf", "fkf", "kf"):
             raise BadInput(f"--filter: expected afkf, fkf or kf, got {filter!r}")
-        if estimator not in ("ekf", "ukf", "diffuse-rls", "geometry"):
-            raise BadInput(
-                f"--estimator: expected ekf, ukf, diffuse-rls or geometry, got {estimator!r}"
-            )
-        if attitude not in ("auto", "horizon", "file"):
-            raise BadInput(f"--attitude: expected auto, horizon or file, got {attitude!r}")
+        check_options(estimator, attitude)
         inputs = _load_inputs(camera, platform, ais, truth, start)
         live = "://" in source or source.isdigit() or source.startswith("/dev/")
         with progress_bar() as bar, _terminate_as_interrupt():
