@@ -10,8 +10,8 @@ For each preset of :data:`seawatch.synth.platform_clip.PRESETS` it renders the c
         --platform CLIP/nav.csv --start 0 --truth CLIP/truth_world.csv \\
         --out CLIP/run --no-video --no-report --json
 
-and scores the run in the platform frame (:func:`score_platform_run`: ranges from the
-moving camera). Writes ``<preset>.json`` next to this script (or ``--results``): the clip,
+and scores the run (:func:`score_platform_run`: against ``truth_world.csv``, ranges from
+the moving camera). Writes ``<preset>.json`` next to this script (or ``--results``): the clip,
 timings, the CLI's own ``errors`` (world-frame truth) and the platform-frame errors per
 estimator and range bin, and the issue's targets evaluated.
 """

@@ -30,13 +30,10 @@ detector that keys on the background flow would see none); the platform's headin
 constant (no yaw), and its pitch and roll are the renderer's sway only. Ship shapes,
 water-line pixels, horizon, occlusion and truth are exact.
 
-Scoring: the pipeline scores ``tracks.csv`` against a truth file with ranges measured from
-the camera file's fixed foot point, which on a moving platform is wrong for the range
-columns and the range bins (the world-position errors and the CLEAR/Identity scores are
-right). :func:`score_platform_run` scores in the platform frame instead: it subtracts the
-NAV position of each row's time from the run's ``tracks.csv``/``estimates.csv`` and scores
-them against the relative ``truth.csv`` (foot point at the origin) — position errors are
-the same in both frames, ranges are now from the moving camera.
+Scoring: :func:`score_platform_run` scores a run against ``truth_world.csv``, whose
+``platform_north_m``/``platform_east_m`` columns make
+:func:`seawatch.metrics.track_errors.score_tracks` measure each row's range from the moving
+camera (the range columns and range bins), world positions as they are.
 
 Presets (:data:`PRESETS`, :func:`platform_clip_preset`):
 
@@ -75,7 +72,6 @@ __all__ = [
     "ClipTarget",
     "PlatformClip",
     "platform_clip_preset",
-    "relative_track_tables",
     "render_platform_clip",
     "score_platform_run",
 ]
@@ -402,59 +398,25 @@ def _world_truth(
 
 
 # ------------------------------------------------------------------------------ scoring
-def relative_track_tables(run_dir: str | Path, nav: str | Path) -> tuple[Path, Path | None]:
-    """Write ``tracks_relative.csv`` (and ``estimates_relative.csv``) into ``run_dir``:
-    the run's tables with every position (``east_m``, ``north_m``) minus the platform's
-    NAV position at the row's ``time`` (video time; NAV time 0 = frame 0) [m].
-
-    Returns the two paths (the second None when the run has no ``estimates.csv``).
-    """
-    from seawatch.io.nav import read_nav
-
-    run = Path(run_dir)
-    track = read_nav(nav)
-    outs: list[Path | None] = []
-    for name in ("tracks", "estimates"):
-        src = run / f"{name}.csv"
-        if not src.is_file():
-            outs.append(None)
-            continue
-        with src.open(newline="", encoding="utf-8") as fh:
-            reader = csv.DictReader(fh)
-            fields = list(reader.fieldnames or [])
-            rows = list(reader)
-        dst = run / f"{name}_relative.csv"
-        times = np.array([float(r["time"]) for r in rows]) if rows else np.zeros(0)
-        pose = track.pose_at(times) if rows else None
-        with dst.open("w", newline="", encoding="utf-8") as fh:
-            w = csv.DictWriter(fh, fields)
-            w.writeheader()
-            for i, r in enumerate(rows):
-                assert pose is not None
-                for col, ref in (("north_m", pose.north[i]), ("east_m", pose.east[i])):
-                    if r.get(col, "") not in ("", None):
-                        r[col] = f"{float(r[col]) - float(ref):.4f}"
-                w.writerow(r)
-        outs.append(dst)
-    return outs[0], outs[1]  # type: ignore[return-value]
-
-
 def score_platform_run(run_dir: str | Path, clip_dir: str | Path, **options: Any) -> Any:
-    """Score a pipeline run on a platform clip in the platform frame (module docstring).
+    """Score a pipeline run on a platform clip (module docstring, "Scoring").
 
-    ``run_dir`` holds the run's ``tracks.csv``/``estimates.csv``; ``clip_dir`` the clip
-    (``truth.csv``, ``nav.csv``, the mounted ``camera.yaml`` whose foot point is the
-    origin). ``options`` go to :func:`seawatch.metrics.track_errors.score_tracks`
-    (default ``min_truth_height`` = the pipeline's ``MIN_TRUTH_PX``). Returns its
+    ``run_dir`` holds the run's ``tracks.csv`` (and ``estimates.csv``); ``clip_dir`` the
+    clip's ``truth_world.csv``. ``options`` go to
+    :func:`seawatch.metrics.track_errors.score_tracks` (default ``min_truth_height`` = the
+    pipeline's ``MIN_TRUTH_PX``). Returns its
     :class:`~seawatch.metrics.track_errors.TrackErrors`: ranges and range bins from the
-    moving camera, position errors equal to the world frame's.
+    moving camera.
     """
     from seawatch.metrics.track_errors import score_tracks
     from seawatch.pipeline import MIN_TRUTH_PX
 
-    clip = Path(clip_dir)
-    tracks, estimates = relative_track_tables(run_dir, clip / "nav.csv")
+    run = Path(run_dir)
+    estimates = run / "estimates.csv"
     opts = {"min_truth_height": MIN_TRUTH_PX, **options}
     return score_tracks(
-        tracks, clip / "truth.csv", camera=clip / "camera.yaml", estimates=estimates, **opts
+        run / "tracks.csv",
+        Path(clip_dir) / "truth_world.csv",
+        estimates=estimates if estimates.is_file() else None,
+        **opts,
     )
