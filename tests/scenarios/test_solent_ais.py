@@ -151,6 +151,20 @@ def test_runs_do_not_depend_on_how_they_are_grouped(scene):
     np.testing.assert_array_equal(a1[0], a3[2])
 
 
+def test_records_do_not_depend_on_the_chunking_of_the_parallel_protocol(table, tmp_path):
+    opts = {"ais": table, "camera_heading": 175.0, "vessels": SMALL}
+    n = sa.CHUNK + 2  # two blocks
+    whole = sa.merge([sa.chunk(range(n), n, 4, **opts)], n, 4, **opts)
+    parts = [sa.chunk(c, n, 4, **opts) for c in (range(0, sa.CHUNK), range(sa.CHUNK, n))]
+    split = sa.merge(parts, n, 4, tmp_path, **opts)
+    assert split.results == whole.results
+    assert {p.name for p in split.outputs} >= {"plan.png", "results.csv"}
+    with pytest.raises(ValueError, match="payloads"):
+        sa.merge(parts[::-1], n, 4, **opts)
+    with pytest.raises(ValueError, match="indices"):
+        sa.chunk([2, 1], n, 4, **opts)
+
+
 # ------------------------------------------------------------------ the target
 def test_filters_are_at_least_30_percent_better_than_geometry_in_position(scene):
     res = sa.evaluate(scene, [0, 1, 2], seed=0)

@@ -200,8 +200,15 @@ AR_ORDER = 5
 FORGETTING = 1.0
 COURSE_MIN_SPEED = 1.0
 """Course errors are scored only where the AIS speed is at least this [m/s]."""
-CHUNK = 25
+CHUNK = 5
 """Monte-Carlo runs processed together (vectorised over runs × passes)."""
+CHUNK_ALIGN = CHUNK
+"""Parallel protocol: chunks start on a block boundary (per-sample error sums are block
+sums, added in block order, so they do not depend on the chunking)."""
+CHUNK_MIN = CHUNK
+PARALLEL_MIN_COST = 100
+"""Parallel protocol: fewer runs than this run in one process unless ``workers`` is given
+(20 runs take ~15 s in one process; a local cluster takes 5–10 s to start)."""
 RANGE_BIN = 250.0
 """Width of the range bins of the error-vs-range plot and table [m]."""
 
@@ -1009,27 +1016,68 @@ def run(
         camera (display units), the AIS file, the vessels and numbers of passes and
         samples, and the time window.
     """
+    options = {
+        "ais": ais,
+        "camera_lat": camera_lat,
+        "camera_lon": camera_lon,
+        "camera_height": camera_height,
+        "camera_heading": camera_heading,
+        "fov": fov,
+        "rate": rate,
+        "sigma_px": sigma_px,
+        "max_range": max_range,
+        "start": start,
+        "duration": duration,
+        "vessels": vessels,
+    }
     n_runs = _runs(runs)
+    if out_dir is not None:  # an unwritable folder fails before any work
+        Path(out_dir).mkdir(parents=True, exist_ok=True)
+    payload = chunk(range(n_runs), n_runs, seed, progress=progress, **options)
+    return merge([payload], n_runs, seed, out_dir, **options)
+
+
+def _scene(options: dict[str, Any]) -> Scene:
+    return build_scene(options.pop("ais", None), **options)
+
+
+def chunk(
+    indices: Sequence[int],
+    runs: int | None = None,
+    seed: int = 0,
+    *,
+    progress: ProgressCallback | None = None,
+    **options: Any,
+) -> dict[str, Any]:
+    """Runs ``indices`` of the experiment (the parallel protocol of
+    :mod:`seawatch.scenarios.parallel`): per-run metrics of every estimator.
+
+    Runs are evaluated in aligned blocks ``[k·CHUNK, (k+1)·CHUNK)`` (vectorised over
+    runs × passes); each block's per-sample squared position errors are summed within
+    the block, so that :func:`merge` adds the same block sums in the same order whatever
+    the chunking (``CHUNK_ALIGN``). Run i's noise depends only on (seed, i).
+
+    Args:
+        indices: global run indices (increasing).
+        runs: total number of runs (unused: a run does not depend on it).
+        seed: random seed.
+        progress: ``progress(done, total)`` after each estimator of each block.
+        options: the scene options of :func:`run` (``ais``, ``camera_lat`` …).
+
+    Returns:
+        A picklable payload: the run indices, per-run metric values per (estimator,
+        metric), the block sums and counts of squared position errors per sample, and
+        for the block holding run 0 the geometry and EKF estimates (the plan view).
+    """
+    idx = [int(i) for i in indices]
+    if not idx or min(idx) < 0 or idx != sorted(set(idx)):
+        raise ValueError(f"indices: expected increasing non-negative run indices, got {indices!r}")
     s = _seed(seed)
-    out = Path(out_dir) if out_dir is not None else None
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-    scene = build_scene(
-        ais,
-        camera_lat=camera_lat,
-        camera_lon=camera_lon,
-        camera_height=camera_height,
-        camera_heading=camera_heading,
-        fov=fov,
-        rate=rate,
-        sigma_px=sigma_px,
-        max_range=max_range,
-        start=start,
-        duration=duration,
-        vessels=vessels,
-    )
-    chunks = [list(range(a, min(a + CHUNK, n_runs))) for a in range(0, n_runs, CHUNK)]
-    total = len(chunks) * len(ESTIMATORS) + 1
+    scene = _scene(dict(options))
+    blocks: dict[int, list[int]] = {}
+    for i in idx:
+        blocks.setdefault(i // CHUNK, []).append(i)
+    total = len(blocks) * len(ESTIMATORS)
     done = [0]
 
     def tick() -> None:
@@ -1037,26 +1085,57 @@ def run(
         if progress is not None:
             progress(done[0], total)
 
-    bound = pcrb(scene)
-    tick()
-    acc = _RunMetrics()
-    outputs: list[Path] = []
-    for chunk in chunks:
-        plan = out is not None and chunk[0] == 0
-        res = evaluate(scene, chunk, s, tick=tick, keep=("geometry", "ekf") if plan else ())
-        acc.runs.extend(chunk)
+    values: dict[tuple[str, str], list[float]] = {}
+    sums: list[tuple[int, dict[str, tuple[FloatArray, FloatArray]]]] = []
+    plan: dict[str, Estimates] | None = None
+    for b, block in blocks.items():
+        first = block[0] == 0
+        res = evaluate(scene, block, s, tick=tick, keep=("geometry", "ekf") if first else ())
+        block_sums = {}
         for name, metrics in res.items():
             e2 = metrics.pop("_e2")
-            acc.sq_pos[name] = acc.sq_pos.get(name, 0.0) + np.nansum(e2, axis=0)
-            acc.n_pos[name] = acc.n_pos.get(name, 0.0) + np.sum(np.isfinite(e2), axis=0)
+            block_sums[name] = (np.nansum(e2, axis=0), np.sum(np.isfinite(e2), axis=0))
             est = metrics.pop("_estimates", None)
-            for metric, values in metrics.items():
-                acc.add(name, metric, values)
             if est is not None:
-                res[name]["_estimates"] = est
-        if plan and out is not None:
-            ests = {n: res[n]["_estimates"] for n in ("geometry", "ekf")}
-            outputs.append(_plot_plan(out / "plan.png", scene, ests))
+                plan = plan or {}
+                plan[name] = est
+            for metric, v in metrics.items():
+                values.setdefault((name, metric), []).extend(np.asarray(v, float).tolist())
+        sums.append((b, block_sums))
+    return {"runs": idx, "values": values, "sums": sums, "plan": plan}
+
+
+def merge(
+    payloads: Sequence[dict[str, Any]],
+    runs: int | None = None,
+    seed: int = 0,
+    out_dir: str | Path | None = None,
+    **options: Any,
+) -> ExperimentResult:
+    """The experiment's records (and outputs in ``out_dir``) from the payloads of
+    :func:`chunk`, given in run order (the parallel protocol of
+    :mod:`seawatch.scenarios.parallel`)."""
+    s = _seed(seed)
+    got = [i for p in payloads for i in p["runs"]]
+    n_runs = len(got)
+    if got != list(range(n_runs)) or (runs is not None and n_runs != runs):
+        raise ValueError(f"payloads: expected runs 0 … {(runs or n_runs) - 1} in order")
+    scene = _scene(dict(options))
+    out = Path(out_dir) if out_dir is not None else None
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+    bound = pcrb(scene)
+    acc = _RunMetrics(runs=got)
+    outputs: list[Path] = []
+    for p in payloads:
+        for (name, metric), v in p["values"].items():
+            acc.add(name, metric, np.asarray(v))
+        for _, block_sums in p["sums"]:  # block order = run order
+            for name, (sq, n) in block_sums.items():
+                acc.sq_pos[name] = acc.sq_pos.get(name, 0.0) + sq
+                acc.n_pos[name] = acc.n_pos.get(name, 0.0) + n
+        if out is not None and p["plan"] is not None:
+            outputs.append(_plot_plan(out / "plan.png", scene, p["plan"]))
     records = _records(scene, acc, bound)
     if out is not None:
         outputs += _write_range_outputs(out, scene, acc, bound)
