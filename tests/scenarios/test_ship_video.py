@@ -6,6 +6,7 @@ import math
 
 import pytest
 
+from seawatch.scenarios import ship_video
 from seawatch.scenarios.ship_video import run
 
 
@@ -33,3 +34,17 @@ def test_bad_arguments_raise():
         run(cases=["tiny"])
     with pytest.raises(ValueError, match="runs"):
         run(runs=0)
+
+
+def test_chunked_units_give_the_records_of_one_run(tmp_path):
+    opts = {"cases": ["large"], "width": 320, "height": 180, "duration": 0.8}
+    assert ship_video.units(2, **opts) == 2
+    whole = run(runs=2, seed=3, **opts)
+    parts = [ship_video.chunk([u], 2, 3, **opts) for u in (0, 1)]
+    split = ship_video.merge(parts, 2, 3, tmp_path, **opts)
+    assert split.results == whole.results and split.extra == whole.extra
+    assert (tmp_path / "cle.csv").read_text().count("\n") == 1 + 2 * 3
+    with pytest.raises(ValueError, match="payloads"):
+        ship_video.merge(parts[:1], 2, 3, **opts)
+    with pytest.raises(ValueError, match="indices"):
+        ship_video.chunk([2], 2, 3, **opts)

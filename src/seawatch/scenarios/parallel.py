@@ -12,8 +12,8 @@ points' chunks at once; a point that fails is reported with its error and the ot
 are kept.
 
 The protocol a scenario module follows to run in parallel (``air_range``, ``uav_sea``,
-``stereo_ferry``, ``clutter_tbd`` and ``solent_ais`` do; a module without it runs in one
-process):
+``stereo_ferry``, ``clutter_tbd``, ``solent_ais`` and ``ship_video`` do; a module without
+it runs in one process):
 
 ``chunk(indices, runs, seed, *, progress=None, **options) -> payload``
     Computes the work units ``indices`` (a ``range``, increasing; by default the

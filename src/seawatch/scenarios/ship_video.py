@@ -24,6 +24,7 @@ interior (neither end of the swept range).
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import tempfile
 from collections.abc import Sequence
@@ -39,12 +40,15 @@ from seawatch.synth import render_case
 from seawatch.synth.cases import CASES
 from seawatch.vision.tracker import FILTERS, VisualTracker, tracks_to_rows
 
-__all__ = ["ORDERS", "run", "track_case"]
+__all__ = ["ORDERS", "chunk", "merge", "run", "track_case", "unit_costs", "units"]
 
 ORDERS: tuple[float, ...] = (0.7, 0.8, 0.9, 0.95, 1.0)
 """Fractional orders of the sweep (ALGORITHMS.md §1.3: tunable 0.8–1.0, default 0.95)."""
 
 SWEEP_CASE = "small"
+PARALLEL_MIN_COST = 5.0
+"""Parallel protocol: a run of less than this (in :func:`unit_costs`, one 960×540 case =
+1) stays in one process unless ``workers`` is given (a local cluster takes 5–10 s)."""
 
 
 def read_truth(path: str | Path) -> np.ndarray:
@@ -77,6 +81,93 @@ def _no_detector(image: Any, **_: Any) -> None:  # pragma: no cover - never call
     raise RuntimeError("track_case runs on precomputed detections")
 
 
+def _names(cases: Sequence[str] | None) -> list[str]:
+    names = list(CASES if cases is None else cases)
+    for n in names:
+        if n not in CASES:
+            raise ValueError(f"cases: unknown case {n!r}; expected some of {', '.join(CASES)}")
+    return names
+
+
+def _runs(runs: object) -> int:
+    if isinstance(runs, bool) or not isinstance(runs, int) or runs < 1:
+        raise ValueError(f"runs: expected an integer >= 1, got {runs!r}")
+    return runs
+
+
+def _orders(orders: Sequence[float]) -> list[float]:
+    alphas = [float(a) for a in orders]
+    if any(not (a > 0) for a in alphas):
+        raise ValueError(f"orders: expected positive fractional orders, got {orders!r}")
+    return alphas
+
+
+def units(runs: int = 1, cases: Sequence[str] | None = None, **_: Any) -> int:
+    """Parallel protocol: one work unit per rendering (run × case)."""
+    return _runs(runs) * len(_names(cases))
+
+
+def unit_costs(
+    runs: int = 1,
+    cases: Sequence[str] | None = None,
+    small_scale: int = 2,
+    orders: Sequence[float] = ORDERS,
+    **_: Any,
+) -> np.ndarray:
+    """Parallel protocol: relative cost of each unit (pixels rendered and detected; the
+    small case is ``small_scale``² larger and is tracked once more per swept order)."""
+    names = _names(cases)
+    one = [small_scale**2 * (1.0 + 0.1 * len(orders)) if n == SWEEP_CASE else 1.0 for n in names]
+    return np.tile(np.array(one), _runs(runs))
+
+
+def _unit(
+    u: int,
+    names: list[str],
+    seed: int,
+    root: Path,
+    keep_folder: bool,
+    runs: int,
+    width: int,
+    height: int,
+    duration: float,
+    orders: list[float],
+    small_scale: int,
+    fps: float,
+) -> dict[str, Any]:
+    """Render, detect and track unit ``u`` (run ``u // len(names)``, case
+    ``names[u % len(names)]``); rows ``(estimator, order, cle_px, cle_percent,
+    precision)`` with order None except in the sweep."""
+    r, i = divmod(u, len(names))
+    name = names[i]
+    k = small_scale if name == SWEEP_CASE else 1
+    folder = root / (name if runs == 1 or not keep_folder else f"{name}-{r}")
+    res = render_case(
+        name, folder, duration=duration, fps=fps, width=width * k, height=height * k, seed=seed + r
+    )
+    dets = detect_video(res.video, VisualTracker(fps=fps))
+    truth = read_truth(res.truth)
+    rows: list[tuple[str, float | None, float, float, float]] = []
+    for est in FILTERS:
+        c = track_case(dets, truth, est)
+        rows.append((est, None, c.mean_px, c.mean_percent, c.precision))
+    if name == SWEEP_CASE:
+        for a in orders:
+            c = track_case(dets, truth, "afkf", order=a)
+            rows.append(("afkf", a, c.mean_px, c.mean_percent, c.precision))
+    return {"run": r, "case": name, "rows": rows}
+
+
+_HEADER = ["case", "run", "estimator", "order", "cle_px", "cle_percent", "precision"]
+
+
+def _csv_rows(unit: dict[str, Any]) -> list[list[Any]]:
+    return [
+        [unit["case"], unit["run"], est, "" if a is None else a, px, pct, prec]
+        for est, a, px, pct, prec in unit["rows"]
+    ]
+
+
 def run(
     runs: int = 1,
     seed: int = 0,
@@ -97,7 +188,8 @@ def run(
         runs: renderings per case (seeds ``seed``, ``seed + 1``, …); records hold the
             mean and standard error over them.
         seed: first rendering seed.
-        out_dir: keep the footage and write ``cle.csv`` here; None: a temporary folder.
+        out_dir: keep the footage and write ``cle.csv`` here (a row per case and filter
+            as it is produced); None: a temporary folder.
         progress: ``progress(done, total)`` after each rendered and tracked case.
         cases: case names (default all of :data:`seawatch.synth.cases.CASES`).
         width, height: frame size [px] (the small case: ``small_scale`` times it).
@@ -107,79 +199,121 @@ def run(
     Returns:
         :class:`ExperimentResult` with records ``cle_px``, ``cle_percent``,
         ``cle_precision`` per estimator (afkf, fkf, kf) and case, and the order sweep.
+        Run on Dask (``--workers``, :mod:`seawatch.scenarios.parallel`), the same records
+        come from :func:`chunk` and :func:`merge`, without the footage.
     """
-    if isinstance(runs, bool) or not isinstance(runs, int) or runs < 1:
-        raise ValueError(f"runs: expected an integer >= 1, got {runs!r}")
-    names = list(CASES if cases is None else cases)
-    for n in names:
-        if n not in CASES:
-            raise ValueError(f"cases: unknown case {n!r}; expected some of {', '.join(CASES)}")
-    alphas = [float(a) for a in orders]
-    if any(not (a > 0) for a in alphas):
-        raise ValueError(f"orders: expected positive fractional orders, got {orders!r}")
-    tmp = None
-    if out_dir is None:
-        tmp = tempfile.TemporaryDirectory(prefix="seawatch-ship-video-")
-        root = Path(tmp.name)
-    else:
+    n_runs = _runs(runs)
+    names = _names(cases)
+    alphas = _orders(orders)
+    opts = {
+        "width": width,
+        "height": height,
+        "duration": duration,
+        "orders": alphas,
+        "small_scale": small_scale,
+        "fps": fps,
+    }
+    with contextlib.ExitStack() as stack:
+        if out_dir is None:
+            root = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="seawatch-sv-")))
+            tw = None
+        else:
+            root = Path(out_dir)
+            root.mkdir(parents=True, exist_ok=True)
+            table = stack.enter_context((root / "cle.csv").open("w", newline="", encoding="utf-8"))
+            tw = csv.writer(table)
+            tw.writerow(_HEADER)
+        done: list[dict[str, Any]] = []
+        total = n_runs * len(names)
+        for u in range(total):
+            done.append(_unit(u, names, seed, root, True, n_runs, **opts))
+            if tw is not None:
+                tw.writerows(_csv_rows(done[-1]))
+                table.flush()
+            if progress is not None:
+                progress(len(done), total)
+    outputs = [] if out_dir is None else [Path(out_dir) / "cle.csv"]
+    return _result(done, names, n_runs, seed, outputs)
+
+
+def chunk(
+    indices: Sequence[int],
+    runs: int = 1,
+    seed: int = 0,
+    *,
+    progress: ProgressCallback | None = None,
+    cases: Sequence[str] | None = None,
+    width: int = 960,
+    height: int = 540,
+    duration: float = 8.0,
+    orders: Sequence[float] = ORDERS,
+    small_scale: int = 2,
+    fps: float = 25.0,
+) -> list[dict[str, Any]]:
+    """Units ``indices`` (run × case, see :func:`units`) of the experiment, rendered in a
+    temporary folder (the parallel protocol of :mod:`seawatch.scenarios.parallel`); a
+    unit's numbers depend only on (seed, run, case)."""
+    names = _names(cases)
+    opts = {
+        "width": width,
+        "height": height,
+        "duration": duration,
+        "orders": _orders(orders),
+        "small_scale": small_scale,
+        "fps": fps,
+    }
+    idx = [int(i) for i in indices]
+    n = _runs(runs) * len(names)
+    if not idx or idx != sorted(set(idx)) or idx[0] < 0 or idx[-1] >= n:
+        raise ValueError(f"indices: expected increasing units in 0 … {n - 1}, got {indices!r}")
+    out = []
+    with tempfile.TemporaryDirectory(prefix="seawatch-sv-") as tmp:
+        for u in idx:
+            out.append(_unit(u, names, seed, Path(tmp) / str(u), False, runs, **opts))
+            if progress is not None:
+                progress(len(out), len(idx))
+    return out
+
+
+def merge(
+    payloads: Sequence[list[dict[str, Any]]],
+    runs: int = 1,
+    seed: int = 0,
+    out_dir: str | Path | None = None,
+    cases: Sequence[str] | None = None,
+    **_: Any,
+) -> ExperimentResult:
+    """The records (and ``cle.csv`` in ``out_dir``) from the payloads of :func:`chunk` in
+    unit order (the parallel protocol of :mod:`seawatch.scenarios.parallel`)."""
+    names = _names(cases)
+    done = [u for p in payloads for u in p]
+    if len(done) != _runs(runs) * len(names):
+        raise ValueError(f"payloads: expected {runs * len(names)} units, got {len(done)}")
+    outputs: list[Path] = []
+    if out_dir is not None:
         root = Path(out_dir)
         root.mkdir(parents=True, exist_ok=True)
+        with (root / "cle.csv").open("w", newline="", encoding="utf-8") as table:
+            tw = csv.writer(table)
+            tw.writerow(_HEADER)
+            for unit in done:
+                tw.writerows(_csv_rows(unit))
+        outputs.append(root / "cle.csv")
+    return _result(done, names, runs, seed, outputs)
+
+
+def _result(
+    done: list[dict[str, Any]], names: list[str], runs: int, seed: int, outputs: list[Path]
+) -> ExperimentResult:
     values: dict[tuple[str, str, str], list[float]] = {}
-    sweep: dict[float, list[float]] = {a: [] for a in alphas}
-    outputs: list[Path] = []
-    table = None
-    if out_dir is not None:
-        table_path = root / "cle.csv"
-        table = table_path.open("w", newline="", encoding="utf-8")
-        tw = csv.writer(table)
-        tw.writerow(["case", "run", "estimator", "order", "cle_px", "cle_percent", "precision"])
-        outputs.append(table_path)
-    total = len(names) * runs
-    done = 0
-    try:
-        for r in range(runs):
-            for name in names:
-                k = small_scale if name == SWEEP_CASE else 1
-                folder = root / (f"{name}" if runs == 1 else f"{name}-{r}")
-                res = render_case(
-                    name,
-                    folder,
-                    duration=duration,
-                    fps=fps,
-                    width=width * k,
-                    height=height * k,
-                    seed=seed + r,
-                )
-                dets = detect_video(res.video, VisualTracker(fps=fps))
-                truth = read_truth(res.truth)
-                for est in FILTERS:
-                    c = track_case(dets, truth, est)
-                    for metric, v in (
-                        ("cle_px", c.mean_px),
-                        ("cle_percent", c.mean_percent),
-                        ("cle_precision", c.precision),
-                    ):
-                        values.setdefault((est, metric, name), []).append(v)
-                    if table is not None:
-                        tw.writerow([name, r, est, "", c.mean_px, c.mean_percent, c.precision])
-                if name == SWEEP_CASE:
-                    for a in alphas:
-                        c = track_case(dets, truth, "afkf", order=a)
-                        sweep[a].append(c.mean_percent)
-                        if table is not None:
-                            tw.writerow(
-                                [name, r, "afkf", a, c.mean_px, c.mean_percent, c.precision]
-                            )
-                if table is not None:
-                    table.flush()
-                done += 1
-                if progress is not None:
-                    progress(done, total)
-    finally:
-        if table is not None:
-            table.close()
-        if tmp is not None:
-            tmp.cleanup()
+    sweep: dict[float, list[float]] = {}
+    for unit in done:
+        for est, a, px, pct, prec in unit["rows"]:
+            if a is None:
+                for metric, v in (("cle_px", px), ("cle_percent", pct), ("cle_precision", prec)):
+                    values.setdefault((est, metric, unit["case"]), []).append(v)
+            else:
+                sweep.setdefault(a, []).append(pct)
     units = {"cle_px": "px", "cle_percent": "%", "cle_precision": "%"}
     results = [
         record(est, metric, units[metric], v, params={"case": name})
