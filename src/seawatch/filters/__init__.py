@@ -1,7 +1,12 @@
 """Estimation filters of the source papers (ALGORITHMS.md §1–§3, §5)."""
 
 from seawatch.filters.adaptive_range import AdaptiveRangeFilter
-from seawatch.filters.diffuse_rls import DiffuseRLS, DiffuseRLSResult, SlidingWindowDiffuseRLS
+from seawatch.filters.diffuse_rls import (
+    DiffuseRLS,
+    DiffuseRLSBank,
+    DiffuseRLSResult,
+    SlidingWindowDiffuseRLS,
+)
 from seawatch.filters.fractional import (
     AdaptiveFractionalKalmanFilter,
     FractionalKalmanFilter,
@@ -17,6 +22,7 @@ __all__ = [
     "AdaptiveFractionalKalmanFilter",
     "AdaptiveRangeFilter",
     "DiffuseRLS",
+    "DiffuseRLSBank",
     "DiffuseRLSResult",
     "ExtendedKalmanFilter",
     "FilterResult",

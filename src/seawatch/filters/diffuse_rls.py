@@ -62,6 +62,7 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -74,6 +75,7 @@ from seawatch.models.angles import wrap_angle
 
 __all__ = [
     "DiffuseRLS",
+    "DiffuseRLSBank",
     "DiffuseRLSResult",
     "SlidingWindowDiffuseRLS",
     "ar_is_stable",
@@ -1094,3 +1096,215 @@ class SlidingWindowDiffuseRLS(_ARFilterBase):
             stability_margin,
         )
         self.window = window
+
+
+# ==========================================================================================
+# many streams at once
+# ==========================================================================================
+
+
+@njit(cache=True)
+def _bank_kernel(
+    slots: NDArray[np.int64],
+    y: FloatArray,
+    missing: NDArray[np.int64],
+    reset: NDArray[np.bool_],
+    cfg: FloatArray,
+    R: FloatArray,
+    z: FloatArray,
+    theta: FloatArray,
+    xbuf: FloatArray,
+    rbuf: FloatArray,
+    mbuf: FloatArray,
+    st: FloatArray,
+    sr: FloatArray,
+    sz: FloatArray,
+    wv: FloatArray,
+    wm: FloatArray,
+    steps: NDArray[np.int64],
+    filt: FloatArray,
+    fc: FloatArray,
+    fc_ok: NDArray[np.bool_],
+) -> None:  # pragma: no cover - compiled
+    """``DiffuseRLSBank.step``: per listed slot and channel, an optional restart, the
+    missing samples, the sample, and (full rank) the forecast read at ``steps``."""
+    J = 0
+    for j in range(steps.shape[0]):
+        J = max(J, steps[j])
+    buf = np.empty(J)
+    channels = cfg.shape[0]
+    for i in range(slots.shape[0]):
+        s = slots[i]
+        ok = J > 0
+        for a in range(channels):
+            if reset[i]:
+                R[a, s] = 0.0
+                z[a, s] = 0.0
+                theta[a, s] = 0.0
+                xbuf[a, s] = 0.0
+                rbuf[a, s] = 0.0
+                mbuf[a, s] = 0.0
+                st[a, s] = 0.0
+                sr[a, s] = 0.0
+                sz[a, s] = 0.0
+            c = cfg[a]
+            angle = c[_C_ANGLE] > 0.0
+            for _ in range(missing[i]):
+                _step(
+                    np.nan, c, R[a, s], z[a, s], theta[a, s], xbuf[a, s], rbuf[a, s],
+                    mbuf[a, s], st[a, s], wv, wm, sr[a, s], sz[a, s],
+                )  # fmt: skip
+            v = _step(
+                y[i, a], c, R[a, s], z[a, s], theta[a, s], xbuf[a, s], rbuf[a, s],
+                mbuf[a, s], st[a, s], wv, wm, sr[a, s], sz[a, s],
+            )  # fmt: skip
+            filt[i, a] = _wrap(v) if angle and math.isfinite(v) else v
+            if J > 0 and int(st[a, s, _S_RANK]) == int(c[_C_N]):
+                stable = _forecast(c, theta[a, s], xbuf[a, s], mbuf[a, s], st[a, s], buf, wv)
+                for j in range(steps.shape[0]):
+                    v = buf[steps[j] - 1]
+                    fc[i, j, a] = _wrap(v) if angle else v
+                ok = ok and stable
+            else:
+                ok = False
+        fc_ok[i] = ok
+
+
+_BANK_ARRAYS = ("_R", "_z", "_theta", "_xbuf", "_rbuf", "_mbuf", "_st", "_sr", "_sz")
+
+
+class DiffuseRLSBank:
+    """Many independent streams of diffuse-RLS AR filters, advanced by one compiled call.
+
+    The bank has ``channels`` filter configurations, given as template filters (for
+    example a track's azimuth, ``DiffuseRLS(5, angle=True)``, and its depression,
+    ``DiffuseRLS(5)``), and ``slots`` streams of each. Slot s of channel c behaves
+    exactly as its own copy of ``templates[c]`` fed the same samples with
+    :meth:`DiffuseRLS.update` and read with :meth:`DiffuseRLS.forecast` (seed 000
+    eqs. 14–16 and 20; ALGORITHMS.md §3) — the tests check it sample by sample — so a
+    tracker can run one filter pair per track without a Python loop over tracks (the
+    track job's world estimators do: ``seawatch.tracking.world``).
+
+    Args:
+        templates: one filter per channel; all must have the same order, intercept and
+            window (the state arrays are stacked).
+        slots: initial number of streams (see :meth:`grow`).
+    """
+
+    def __init__(
+        self, templates: Sequence[DiffuseRLS | SlidingWindowDiffuseRLS], slots: int = 16
+    ) -> None:
+        if isinstance(templates, _ARFilterBase) or len(templates) == 0:
+            raise ValueError("templates: expected a non-empty sequence of DiffuseRLS filters")
+        for t in templates:
+            if not isinstance(t, _ARFilterBase):
+                raise ValueError(f"templates: expected DiffuseRLS filters, got {type(t).__name__}")
+        first = templates[0]
+        for t in templates[1:]:
+            if (t.n_params, t._buf_len, t._cfg[_C_WINDOW]) != (
+                first.n_params,
+                first._buf_len,
+                first._cfg[_C_WINDOW],
+            ):
+                raise ValueError("templates: expected the same order, intercept and window")
+        self.channels = len(templates)
+        self.n_params = first.n_params
+        self._cfg = np.stack([t._cfg for t in templates])
+        self._len = first._buf_len
+        self._window = int(first._cfg[_C_WINDOW])
+        n, p = self.n_params, first.order
+        self._wv = np.zeros(3 * n + 2 * p)
+        self._wm = np.zeros((2, n, n))
+        self.slots = 0
+        self.grow(_int_at_least("slots", slots, 1))
+
+    def grow(self, slots: int) -> None:
+        """Hold ``slots`` streams, keeping the existing ones (new ones at the diffuse start)."""
+        size = _int_at_least("slots", slots, self.slots)
+        C, n, L, w = self.channels, self.n_params, self._len, self._window + 1
+        shapes = {
+            "_R": (n, n),
+            "_z": (n,),
+            "_theta": (n,),
+            "_xbuf": (L,),
+            "_rbuf": (L,),
+            "_mbuf": (L,),
+            "_st": (_S_SIZE,),
+            "_sr": (w, n, n),
+            "_sz": (w, n),
+        }
+        for name, tail in shapes.items():
+            arr = np.zeros((C, size, *tail))
+            if self.slots:
+                arr[:, : self.slots] = getattr(self, name)
+            setattr(self, name, arr)
+        self.slots = size
+
+    def clear(self, slots: ArrayLike) -> None:
+        """Return these streams to the diffuse start (:meth:`DiffuseRLS.reset`)."""
+        idx = self._slots(slots)
+        for name in _BANK_ARRAYS:
+            getattr(self, name)[:, idx] = 0.0
+
+    def _slots(self, slots: ArrayLike) -> NDArray[np.int64]:
+        idx = np.atleast_1d(np.asarray(slots))
+        if idx.ndim != 1 or (idx.size and not np.issubdtype(idx.dtype, np.integer)):
+            raise ValueError(f"slots: expected a 1-D array of integer slot numbers, got {slots!r}")
+        idx = idx.astype(np.int64)
+        if idx.size and (idx.min() < 0 or idx.max() >= self.slots):
+            raise ValueError(f"slots: expected slot numbers in 0 … {self.slots - 1}")
+        if np.unique(idx).size != idx.size:
+            raise ValueError("slots: expected each slot at most once per step")
+        return idx
+
+    def step(
+        self,
+        slots: ArrayLike,
+        samples: ArrayLike,
+        *,
+        missing: ArrayLike | None = None,
+        reset: ArrayLike | None = None,
+        steps: ArrayLike = (),
+    ) -> tuple[FloatArray, FloatArray, NDArray[np.bool_]]:
+        """Advance the listed streams by one sample each.
+
+        Per listed slot: restart first where ``reset`` (the diffuse start), then
+        ``missing`` missing samples (each a :meth:`DiffuseRLS.update` with NaN), then the
+        sample, then — where the information matrix has full rank — the AR forecast
+        (seed eq. 20) read ``steps`` samples ahead.
+
+        Args:
+            slots: (k,) distinct slot numbers.
+            samples: (k, channels) samples (radians for angle channels; NaN = missing).
+            missing: (k,) missing samples before each sample (default 0).
+            reset: (k,) restart flags (default none).
+            steps: (J,) forecast lead times in samples, each ≥ 1 (default none).
+
+        Returns:
+            filtered (k, channels) levels (wrapped to (−π, π] for angle channels),
+            forecasts (k, J, channels) (NaN before full rank), and (k,) flags: every
+            channel's forecast exists and its AR model is stable.
+        """
+        idx = self._slots(slots)
+        k = idx.size
+        y = np.asarray(samples, dtype=np.float64)
+        if y.shape != (k, self.channels):
+            raise ValueError(f"samples: expected shape ({k}, {self.channels}), got {y.shape}")
+        miss = np.zeros(k, np.int64) if missing is None else np.asarray(missing, np.int64)
+        if miss.shape != (k,) or (k and miss.min() < 0):
+            raise ValueError(f"missing: expected ({k},) counts >= 0")
+        rst = np.zeros(k, np.bool_) if reset is None else np.asarray(reset, np.bool_)
+        if rst.shape != (k,):
+            raise ValueError(f"reset: expected ({k},) flags, got shape {rst.shape}")
+        lead = np.asarray(steps, dtype=np.int64).reshape(-1)
+        if lead.size and lead.min() < 1:
+            raise ValueError(f"steps: expected lead times >= 1, got {steps!r}")
+        filt = np.empty((k, self.channels))
+        fc = np.full((k, lead.size, self.channels), np.nan)
+        ok = np.zeros(k, dtype=np.bool_)
+        _bank_kernel(
+            idx, np.ascontiguousarray(y), miss, rst, self._cfg, self._R, self._z, self._theta,
+            self._xbuf, self._rbuf, self._mbuf, self._st, self._sr, self._sz, self._wv,
+            self._wm, lead, filt, fc, ok,
+        )  # fmt: skip
+        return filt, fc, ok

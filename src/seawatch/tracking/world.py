@@ -143,11 +143,7 @@ from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from seawatch._validation import FloatArray, as_float_array, covariance, in_range, positive
-from seawatch.filters.diffuse_rls import _S_RANK as _RLS_RANK
-from seawatch.filters.diffuse_rls import _S_SIZE as _RLS_STATE_SIZE
-from seawatch.filters.diffuse_rls import DiffuseRLS
-from seawatch.filters.diffuse_rls import _forecast as _rls_forecast
-from seawatch.filters.diffuse_rls import _step as _rls_step
+from seawatch.filters.diffuse_rls import DiffuseRLS, DiffuseRLSBank
 from seawatch.geometry.sea import DEFAULT_REFRACTION, EARTH_RADIUS
 
 __all__ = [
@@ -175,10 +171,6 @@ AR_ORDER = 5
 
 VELOCITY_CAPACITY = 256
 """Most samples per track kept for the velocity slope of ``geometry``/``diffuse-rls``."""
-
-_RLS_ARRAYS = ("_rR", "_rz", "_rtheta", "_rx", "_rr", "_rm", "_rst", "_rsr", "_rsz")
-"""Per-slot diffuse-RLS state arrays, each with a leading (azimuth, depression) axis."""
-
 
 _TWO_PI = 2.0 * math.pi
 
@@ -421,80 +413,6 @@ def _push_and_slope(
         if stt > 0.0:
             vel[i, 0] = c0 / stt
             vel[i, 1] = c1 / stt
-
-
-@njit(cache=True)
-def _rls_bank(
-    slots: NDArray[np.int64],
-    y: FloatArray,
-    missing: NDArray[np.int64],
-    reset: NDArray[np.bool_],
-    cfg: FloatArray,
-    angle: NDArray[np.bool_],
-    n: int,
-    R: FloatArray,
-    z: FloatArray,
-    theta: FloatArray,
-    xbuf: FloatArray,
-    rbuf: FloatArray,
-    mbuf: FloatArray,
-    st: FloatArray,
-    sr: FloatArray,
-    sz: FloatArray,
-    wv: FloatArray,
-    wm: FloatArray,
-    steps: NDArray[np.int64],
-    filt: FloatArray,
-    fc: FloatArray,
-    fc_ok: NDArray[np.bool_],
-) -> None:
-    """Diffuse RLS of both angle series (a = 0 azimuth, 1 depression) of k tracks.
-
-    Per track and angle: optional restart (``DiffuseRLS.reset``), ``missing[i]`` missing
-    samples and then the sample ``y[i, a]`` (``DiffuseRLS.update``, seed 000 eqs. 14–16
-    and the filtered value of eq. 20), then, when the information matrix has full rank,
-    the AR forecast of ``max(steps)`` samples (``DiffuseRLS.forecast``, eq. 20) read at
-    ``steps``. ``fc_ok[i]``: both angles' forecasts exist and are stable. The state
-    arrays have a leading axis (angle, slot) and the layout of ``DiffuseRLS``'s own.
-    """
-    J = 0
-    for j in range(steps.shape[0]):
-        J = max(J, steps[j])
-    buf = np.empty(J)
-    for i in range(slots.shape[0]):
-        s = slots[i]
-        ok = J > 0
-        for a in range(2):
-            if reset[i]:
-                R[a, s] = 0.0
-                z[a, s] = 0.0
-                theta[a, s] = 0.0
-                xbuf[a, s] = 0.0
-                rbuf[a, s] = 0.0
-                mbuf[a, s] = 0.0
-                st[a, s] = 0.0
-                sr[a, s] = 0.0
-                sz[a, s] = 0.0
-            c = cfg[a]
-            for _ in range(missing[i]):
-                _rls_step(
-                    np.nan, c, R[a, s], z[a, s], theta[a, s], xbuf[a, s], rbuf[a, s],
-                    mbuf[a, s], st[a, s], wv, wm, sr[a, s], sz[a, s],
-                )  # fmt: skip
-            v = _rls_step(
-                y[i, a], c, R[a, s], z[a, s], theta[a, s], xbuf[a, s], rbuf[a, s],
-                mbuf[a, s], st[a, s], wv, wm, sr[a, s], sz[a, s],
-            )  # fmt: skip
-            filt[i, a] = _wrap(v) if angle[a] and math.isfinite(v) else v
-            if J > 0 and int(st[a, s, _RLS_RANK]) == n:
-                stable = _rls_forecast(c, theta[a, s], xbuf[a, s], mbuf[a, s], st[a, s], buf, wv)
-                for j in range(steps.shape[0]):
-                    v = buf[steps[j] - 1]
-                    fc[i, j, a] = _wrap(v) if angle[a] else v
-                ok = ok and stable
-            else:
-                ok = False
-        fc_ok[i] = ok
 
 
 # ==========================================================================================
@@ -988,13 +906,7 @@ class WorldTracker:
             DiffuseRLS(self.ar_order, self.forgetting, angle=True, **opts),
             DiffuseRLS(self.ar_order, self.forgetting, angle=False, **opts),
         )
-        self._rls_cfg = np.stack([r._cfg for r in rls])
-        self._rls_n = rls[0].n_params
-        self._rls_len = rls[0]._buf_len
-        self._rls_angle = np.array([True, False])
-        p, n = self.ar_order, self._rls_n
-        self._rls_wv = np.zeros(3 * n + 2 * p)
-        self._rls_wm = np.zeros((2, n, n))
+        self._rls = DiffuseRLSBank(rls, 16)
         self._T = self.frame_interval
         self._time: float | None = None
         self._slot_of: dict[int, int] = {}
@@ -1006,7 +918,6 @@ class WorldTracker:
     def _alloc(self, size: int) -> None:
         """Grow the per-track storage to ``size`` slots (keeping the existing ones)."""
         C = VELOCITY_CAPACITY
-        n, L = self._rls_n, self._rls_len
         old = self._n
         shapes: dict[str, tuple[tuple[int, ...], float, type]] = {
             "_last": ((size,), np.nan, np.float64),
@@ -1015,15 +926,6 @@ class WorldTracker:
             "_Pe": ((size, 4, 4), 0.0, np.float64),
             "_Xu": ((size, 4), 0.0, np.float64),
             "_Pu": ((size, 4, 4), 0.0, np.float64),
-            "_rR": ((2, size, n, n), 0.0, np.float64),
-            "_rz": ((2, size, n), 0.0, np.float64),
-            "_rtheta": ((2, size, n), 0.0, np.float64),
-            "_rx": ((2, size, L), 0.0, np.float64),
-            "_rr": ((2, size, L), 0.0, np.float64),
-            "_rm": ((2, size, L), 0.0, np.float64),
-            "_rst": ((2, size, _RLS_STATE_SIZE), 0.0, np.float64),
-            "_rsr": ((2, size, 1, n, n), 0.0, np.float64),
-            "_rsz": ((2, size, 1, n), 0.0, np.float64),
         }
         for pre in ("_g", "_d"):  # velocity ring buffers of geometry / diffuse-rls
             shapes[pre + "T"] = ((size, C), 0.0, np.float64)
@@ -1033,12 +935,9 @@ class WorldTracker:
         for name, (shape, fill, dtype) in shapes.items():
             arr = np.full(shape, fill, dtype=dtype)
             if old:
-                src = getattr(self, name)
-                if name in _RLS_ARRAYS:
-                    arr[:, :old] = src
-                else:
-                    arr[:old] = src
+                arr[:old] = getattr(self, name)
             setattr(self, name, arr)
+        self._rls.grow(size)
         self._free.extend(range(size - 1, old - 1, -1))
         self._n = size
 
@@ -1051,8 +950,7 @@ class WorldTracker:
         for pre in ("_g", "_d"):
             getattr(self, pre + "count")[s] = 0
             getattr(self, pre + "head")[s] = 0
-        for name in _RLS_ARRAYS:
-            getattr(self, name)[:, s] = 0.0  # the diffuse start (DiffuseRLS.reset)
+        self._rls.clear(s)  # the diffuse start (DiffuseRLS.reset)
         return s
 
     # ------------------------------------------------------------------ queries
@@ -1262,7 +1160,6 @@ class WorldTracker:
     ) -> WorldEstimates:
         k = ids.shape[0]
         T = self._T
-        H = len(self.horizons)
         reset = dt > self.max_gap
         if T is None:
             missing = np.zeros(k, dtype=np.int64)
@@ -1271,15 +1168,9 @@ class WorldTracker:
             missing = np.maximum(np.rint(dt / T).astype(np.int64) - 1, 0)
             steps = np.maximum(np.rint(self._horizons / T).astype(np.int64), 1)
         missing[reset | (dt <= 0.0)] = 0
-        filt = np.empty((k, 2))
-        fca = np.full((k, H, 2), np.nan)
-        ar_ok = np.zeros(k, dtype=np.bool_)
-        _rls_bank(
-            slots, np.stack([az, dep], axis=-1), missing, reset, self._rls_cfg,
-            self._rls_angle, self._rls_n, self._rR, self._rz, self._rtheta, self._rx,
-            self._rr, self._rm, self._rst, self._rsr, self._rsz, self._rls_wv, self._rls_wm,
-            steps, filt, fca, ar_ok,
-        )  # fmt: skip
+        filt, fca, ar_ok = self._rls.step(
+            slots, np.stack([az, dep], axis=-1), missing=missing, reset=reset, steps=steps
+        )
         on, oe = platform.north, platform.east
         fix = self._fix(filt[:, 0], filt[:, 1], Sigma, h, on, oe, sp2)
         vel = np.empty((k, 2))
