@@ -61,6 +61,7 @@ results: $(VENV)/.installed-test
 	$(BIN)/seawatch demo --out out/demo --json > $(R)/demo/summary.json
 	$(BIN)/python $(R)/track/measure.py --out out/track-targets
 	$(BIN)/seawatch bench video --repeats 2 --json > $(R)/bench/video.json
+	$(BIN)/seawatch bench world --json > $(R)/bench/world.json
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .ruff_cache .hypothesis
