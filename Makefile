@@ -58,6 +58,8 @@ results: $(VENV)/.installed-test
 	$(BIN)/seawatch experiment solent-ais --runs 20 --seed 0 --out $(R)/solent-ais
 	$(BIN)/seawatch experiment ship-video --seed 0 --out $(R)/ship-video
 	$(BIN)/seawatch experiment stereo-ferry --runs 1000 --seed 0 --out $(R)/stereo-ferry
+	$(BIN)/seawatch experiment stereo-ferry --runs 1000 --seed 0 --variant stereo-prior \
+		--out $(R)/stereo-ferry/stereo-prior
 	$(BIN)/seawatch demo --out out/demo --json > $(R)/demo/summary.json
 	$(BIN)/python $(R)/track/measure.py --out out/track-targets
 	$(BIN)/seawatch bench video --repeats 2 --json > $(R)/bench/video.json

@@ -119,7 +119,8 @@ def experiment(
         str | None,
         typer.Option(
             help="clutter-tbd: the linearity test, orthogonal (default: ALGORITHMS.md §8.2's "
-            "alternative) or spec (§8.1's pooled LS residual)."
+            "alternative) or spec (§8.1's pooled LS residual); stereo-ferry: the shared P0, "
+            "matched (default) or stereo-prior (speed sigma = the stereo video's accuracy)."
         ),
     ] = None,
     ais: Annotated[Path | None, typer.Option(help="solent-ais: AIS CSV or NMEA file.")] = None,

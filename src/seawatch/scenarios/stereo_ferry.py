@@ -45,13 +45,21 @@ durations, the rest is ours):
   the along-track triangulation at the current (true) point for 0.5 px per coordinate,
   ``R_k = uᵀ Σ(X_k) u`` (:func:`seawatch.camera.triangulation_covariance`), the §6.3
   depth error ``Z² σ_d / (f B)`` of this unrectified rig: 0.91 m (1σ) at 17.9 m,
-  5.2 m at 43 m, 39 m at 118 m, 285 m at 318 m. One **P0**: ``diag(R_0, (0.1 m/s)²)``.
-  Every filter starts at frame 0 from ``x0 = [z_0, v_0]`` and filters frames 1…N−1;
-  KF and STKF take the paper's speed guess ``v_0`` = 1.5 / 2.2 m/s, stereo + STKF the
-  stereo-measured 1.5683 / 2.2509 m/s — the only difference between the last two.
-  STKF: β = 4.5, ρ = 0.95, Zhou's order (fading factor from the current innovation,
-  ALGORITHMS.md §2); ``late_fading=True`` adds the seed-literal one-step-late order as
-  an ablation (estimators ``stkf-late``, ``stereo-stkf-late``).
+  5.2 m at 43 m, 39 m at 118 m, 285 m at 318 m. One **P0**, ``diag(R_0, σ_v0²)``, in
+  two readings (``variant=``, :data:`VARIANTS`, ``seawatch experiment stereo-ferry
+  --variant stereo-prior``): ``"matched"`` (default) σ_v0 = 0.1 m/s, covering what the
+  initial speeds are actually off by (the guesses 0.068 / 0.051 m/s, the truth's
+  frame-0 fluctuation 0.05 m/s); ``"stereo-prior"`` σ_v0 = :func:`stereo_speed_std`,
+  the accuracy of the speed the 16-s stereo video measures — the Cramér–Rao bound of a
+  constant-speed fit through its 400 fixes with the R above, 0.0265 / 0.0355 m/s
+  (brute-force tested) — i.e. the paper's initial speed used as if known to stereo
+  accuracy, also by the KF and STKF whose guess is 2.6 / 1.4 σ_v0 off. Every filter
+  starts at frame 0 from ``x0 = [z_0, v_0]`` and filters frames 1…N−1; KF and STKF take
+  the paper's speed guess ``v_0`` = 1.5 / 2.2 m/s, stereo + STKF the stereo-measured
+  1.5683 / 2.2509 m/s — the only difference between the last two. STKF: β = 4.5,
+  ρ = 0.95, Zhou's order (fading factor from the current innovation, ALGORITHMS.md §2);
+  ``late_fading=True`` adds the seed-literal one-step-late order as an ablation
+  (estimators ``stkf-late``, ``stereo-stkf-late``).
 
 Randomness: run i of experiment e draws from ``SeedSequence(seed, spawn_key=(e − 1,
 i))`` and every step treats the runs of a batch independently, so a run's numbers do
@@ -83,7 +91,8 @@ true-range band (params ``{"experiment": e, "range_m": [lo, hi]}``). The homogen
 DLT is computed in the rig's native millimetres (the unit of the seed's tables; it is
 not invariant to the world unit).
 
-Outcome (1000 runs, seed 0; position [m] / speed [m/s], paper's metric, whole run):
+Outcome (1000 runs, seed 0; position [m] / speed [m/s], paper's metric, whole run; both
+variants give these to four figures):
 
 =============  ===============  ===============  ===============  ===============
 filter         exp. 1 ours      exp. 1 paper     exp. 2 ours      exp. 2 paper
@@ -93,28 +102,67 @@ STKF           353.6 / 9447     0.3706 / 0.1054  340.7 / 9119     0.8218 / 0.160
 stereo + STKF  353.6 / 9447     0.3373 / 0.0911  340.7 / 9119     0.5579 / 0.1258
 =============  ===============  ===============  ===============  ===============
 
-(standard errors 4–11 m and 140–280 m/s). The paper's ordering KF > STKF > stereo + STKF
-does **not** hold:
+(standard errors 4–11 m and 140–280 m/s). First 16 s (the video; range 18–43 / 18–54 m),
+``stereo-prior``, against the observation (the paper's metric) and against the truth:
+
+=============  ===============  ===============  ===============  ===============
+filter         exp. 1 obs.      exp. 1 truth     exp. 2 obs.      exp. 2 truth
+=============  ===============  ===============  ===============  ===============
+KF             3.117 / 109.4    0.280 / 0.058    4.650 / 163.7    0.293 / 0.050
+STKF           3.291 / 109.7    1.042 / 1.072    4.993 / 164.3    1.759 / 2.382
+stereo + STKF  3.287 / 109.7    1.027 / 1.050    4.991 / 164.3    1.748 / 2.364
+=============  ===============  ===============  ===============  ===============
+
+(``matched``: within 0.003 m of these against the observation, 0.025 m and 0.025 m/s
+against the truth; standard errors 0.006–0.017 m, 0.25–0.44 m/s, 0.004–0.024 m and
+0.0007–0.11 m/s.) The paper's ordering KF > STKF > stereo + STKF does **not** hold in
+either variant, so the filters' exact model (``matched``) stays the default:
 
 * The magnitudes are set by the stereo range error, not by the filters: σ grows as Z²
   from 0.9 m at 18 m to 285 m at 318 m (a 0.2 m baseline with 0.5 px cannot range a
   ship 300 m away: the disparity there is 0.7 px). The paper's 0.34–1.39 m need a
-  measurement noise of a few tenths of a metre, about 10 m range for this rig. In the
-  first 16 s (range 18–43 / 18–54 m) the paper's metric is 3.12 / 3.29 / 3.29 m
-  (exp. 1) and 4.65 / 5.00 / 4.99 m (exp. 2). The speed "observation" Δz/Δt carries
-  √2 σ / Δt of noise (35 σ), so that column is the same for every filter.
-* KF < STKF everywhere: with Q and R matched to the simulation the KF is the optimal
-  filter (NIS 1.01 in the first 16 s). With β = 4.5, ρ = 0.95 (about two samples of
-  memory, ALGORITHMS.md §2) the fading factor fires on chance large innovations (1–2 %
-  of frames in the first 16 s, 9 % over the run, where the seed's triangulation gives
-  biased, heavy-tailed ranges), and since the converged prior ``H F P Fᵀ Hᵀ`` is much
-  smaller than R, ``λ = tr N / tr M`` is large (up to the clamp of 100) and throws the
-  speed estimate off (truth-referenced speed error in the first 16 s: KF 0.057 m/s,
-  STKF 1.08 m/s). The seed-literal one-step-late fading is less harmful (274 / 265 m).
-* STKF > stereo + STKF holds only as a start-up transient: the initial speed (0.068 /
-  0.051 m/s closer to the truth) is the only difference between them; in the first
-  seconds stereo + STKF is better (paired difference > 3 s.e. in the first 4 s), after
-  that the two coincide (identical to four figures over the whole run).
+  measurement noise of a few tenths of a metre, about 10 m range for this rig. The
+  speed "observation" Δz/Δt carries √2 σ / Δt of noise (35 σ: the 109 / 164 m/s above).
+* STKF > stereo + STKF holds in the first 16 s, in every column, by a little: the
+  initial speed (0.068 / 0.051 m/s closer to the truth) is the only difference between
+  them (paired difference > 3 s.e. in the first 4 s, tested); over the whole run the
+  two coincide to four figures.
+* KF > STKF holds nowhere — both columns, both experiments, the video and the whole
+  run, against the observation and the truth, with either P0. Issue 8's reading was
+  that a KF trusting its initial speed stays stuck with the guess's 0.07 m/s error while
+  the STKF's fading factor detects it. Neither happens:
+
+  - The fading test (ALGORITHMS.md §2) passes when the innovation power exceeds about
+    β R, so an innovation bias b shows only if b² ≳ (β − 1) R, b ≳ 1.9 σ_z: 1.7 m at
+    18 m, 9.7 m at 43 m (the end of the video). The guess gives b ≤ 0.068 t ≤ 1.1 m
+    (tested). The factor does not see it: with ``stereo-prior`` it fires on 1.71 % of
+    the frames of the first 2 s with the guess and 1.66 % with the stereo speed
+    (exp. 2: 1.68 / 1.64 %), on 1.9–2.3 % over 2–16 s and on 10 % beyond 16 s
+    (``diagnostics.fading_fraction_by_period``) — chance firings (white unit
+    innovations pass the test on 0.6 % of frames, and each firing disturbs the state
+    and makes the next likelier) and, far out, the heavy tails of the seed's
+    triangulation (KF mean NIS over the run 4.0 / 4.6; 1.01 in the first 16 s).
+  - A false firing is costly: with R much larger than the converged prior
+    ``H F P Fᵀ Hᵀ``, ``λ = tr N / tr M`` is large (median 7, up to the clamp of 100)
+    and multiplies the speed variance too, so the update turns into a two-point
+    differentiator with a speed error of order √2 σ_z / Δt; the long memory of a
+    low-Q filter keeps it and it re-triggers the test. The seed-literal one-step-late
+    fading is less harmful (274 / 265 m, whole run) but still behind the KF.
+  - The KF is not stuck: Q (the truth's own fluctuation) adds (0.068 m/s)² of speed
+    variance in 18 s and the measurements take it from there; its speed error against
+    the truth over the video is 0.058 / 0.050 m/s, below the guess's error.
+
+* Where the ordering would appear: with ``stereo-prior`` and a larger guess error
+  (400 runs, first 16 s, position column), KF > STKF once the guess is 0.5 m/s off
+  (exp. 1; at 0.4 m/s the KF is still 0.02 m ahead) or 0.7 m/s (exp. 2; at 0.5 m/s
+  0.10 m ahead) — 7–14 × the paper's error; at 1 m/s the factor fires on the mismatch
+  and KF > STKF > stereo + STKF holds in the position column (tested). The speed column
+  is the wrong way at every guess error: its differentiation noise hides the filters'
+  speed errors, and the STKF's false firings add 0.3 / 0.7 m/s to it. If the paper's
+  speed observation is such a difference, its 0.09–0.26 m/s imply σ_z ≤ 2.6–7.5 mm:
+  nearly noise-free observations (its pixel coordinates are interpolated linearly
+  between frames 1 and 400), the one regime where the innovations show a 0.07 m/s
+  speed error and nothing else.
 
 Triangulation (same runs, every 10th frame, median range error; ALGORITHMS.md §6.1):
 the seed's inhomogeneous least squares understates the range by 0.25 m below 50 m,
@@ -160,7 +208,15 @@ SPEED_FLUCTUATION_MPS = 0.05
 SPEED_CORRELATION_S = 20.0
 """Correlation time τ of the truth's speed fluctuation (Ornstein–Uhlenbeck) [s]."""
 INITIAL_SPEED_STD_MPS = 0.1
-"""Speed standard deviation of the shared P0 [m/s] (covers the guesses' 0.07/0.05 m/s error)."""
+"""Speed standard deviation of the shared P0 in the ``matched`` variant [m/s] (covers the
+guesses' 0.07 / 0.05 m/s error and the truth's 0.05 m/s fluctuation at frame 0)."""
+VARIANTS: dict[str, str] = {
+    "matched": "P0 speed sigma 0.1 m/s, covering the initial-speed errors (default)",
+    "stereo-prior": "P0 speed sigma = the stereo speed accuracy of the 16-s video "
+    "(stereo_speed_std: 0.027 / 0.035 m/s), trusted by all three filters",
+}
+"""Readings of the shared P0 (``variant=``); Q and R are the same in both."""
+DEFAULT_VARIANT = "matched"
 VIDEO_WINDOW_S = 16.0
 """Length of the paper's stereo video (400 frames) [s]: the early window reported."""
 RANGE_BANDS_M: tuple[tuple[float, float], ...] = (
@@ -185,6 +241,13 @@ added in block order, so chunks starting on multiples of 50 give bit-identical o
 (the records are per-run values and never depend on the chunking)."""
 COMPARE_EVERY = 10
 """The triangulation comparison uses every 10th frame of every run."""
+FADING_PERIODS_S: tuple[tuple[str, float, float], ...] = (
+    ("0-2s", 0.0, 2.0),
+    ("2-16s", 2.0, VIDEO_WINDOW_S),
+    ("16s-end", VIDEO_WINDOW_S, math.inf),
+)
+"""Time periods (name, from, to) [s] of the fading-factor diagnostics: the start-up,
+where a wrong initial speed would show, the rest of the 16-s video and the far range."""
 
 ESTIMATORS = ("kf", "stkf", "stereo-stkf")
 """The paper's three filters, INTERFACES.md names."""
@@ -517,23 +580,79 @@ def process_noise(
     return constant_velocity(1, DT_S, math.sqrt(q / DT_S))
 
 
-def initial_state(z0: ArrayLike, R0: ArrayLike, speed: float) -> tuple[FloatArray, FloatArray]:
-    """Shared start: ``x0 = [z_0, v_0]``, ``P0 = diag(R_0, (0.1 m/s)²)`` per run.
+def stereo_speed_std(
+    experiment: FerryExperiment,
+    sigma_px: float = MATCH_SIGMA_PX,
+    frames: int = SEED_VIDEO_FRAMES,
+    geometry: FerryGeometry | None = None,
+) -> float:
+    """Accuracy [m/s] of the speed the stereo video measures: the ``stereo-prior`` P0.
+
+    The Cramér–Rao bound of the speed of a constant-speed path from ``frames`` stereo
+    fixes (the paper's 400 frames, 16 s) with independent along-track errors of
+    variance ``R(s_k)`` (:func:`along_track_variance`, ``sigma_px`` per pixel
+    coordinate; ALGORITHMS.md §6.3): the speed entry of ``(Aᵀ W A)⁻¹`` with rows
+    ``A_k = [1, t_k]``, ``t_k = k Δt``, ``W = diag(1 / R(v̄ t_k))`` — the standard
+    deviation of the weighted least-squares slope through the partial trajectory.
+    Seed 003's own estimate, the distance between the first and last fixes over 16 s,
+    is far worse (``√(R_0 + R_399) / 16 s`` = 0.33 / 0.52 m/s).
+
+    Args:
+        experiment: the experiment (its v̄ sets the ranges).
+        sigma_px: matching noise per coordinate [px].
+        frames: number of video frames.
+        geometry: the path (default :func:`ferry_geometry`).
+
+    Returns:
+        σ_v [m/s] (0.0265 for experiment 1, 0.0355 for experiment 2 at 0.5 px).
+    """
+    if isinstance(frames, bool) or not isinstance(frames, int | np.integer) or frames < 2:
+        raise ValueError(f"frames: expected an integer >= 2, got {frames!r}")
+    geo = ferry_geometry() if geometry is None else geometry
+    t = np.arange(int(frames)) * DT_S
+    w = 1.0 / along_track_variance(geo, experiment.speed * t, sigma_px)
+    info = np.array([[np.sum(w), np.sum(w * t)], [np.sum(w * t), np.sum(w * t * t)]])
+    return float(math.sqrt(np.linalg.inv(info)[1, 1]))
+
+
+def _check_variant(variant: str) -> str:
+    if not isinstance(variant, str) or variant not in VARIANTS:
+        raise ValueError(f"variant: expected one of {', '.join(VARIANTS)}, got {variant!r}")
+    return variant
+
+
+def initial_speed_std(experiment: FerryExperiment, variant: str = DEFAULT_VARIANT) -> float:
+    """Speed standard deviation of the shared P0 [m/s] in a variant (:data:`VARIANTS`).
+
+    ``"matched"``: :data:`INITIAL_SPEED_STD_MPS`; ``"stereo-prior"``:
+    :func:`stereo_speed_std` of the experiment.
+    """
+    if _check_variant(variant) == "stereo-prior":
+        return stereo_speed_std(experiment)
+    return INITIAL_SPEED_STD_MPS
+
+
+def initial_state(
+    z0: ArrayLike, R0: ArrayLike, speed: float, speed_std: float = INITIAL_SPEED_STD_MPS
+) -> tuple[FloatArray, FloatArray]:
+    """Shared start: ``x0 = [z_0, v_0]``, ``P0 = diag(R_0, speed_std²)`` per run.
 
     Args:
         z0: first measurement(s) [m], (B,).
         R0: their variance [m²], (B,).
         speed: v_0 [m/s].
+        speed_std: standard deviation of v_0 [m/s] (:func:`initial_speed_std`).
 
     Returns:
         x0 (B, 2), P0 (B, 2, 2).
     """
     z = np.atleast_1d(as_float_array("z0", z0))
     r = np.broadcast_to(as_float_array("R0", R0), z.shape)
+    sv = positive("speed_std", speed_std)
     x0 = np.stack([z, np.full(z.shape, float(speed))], axis=-1)
     P0 = np.zeros((*z.shape, 2, 2))
     P0[..., 0, 0] = r
-    P0[..., 1, 1] = INITIAL_SPEED_STD_MPS**2
+    P0[..., 1, 1] = sv**2
     return x0, P0
 
 
@@ -561,6 +680,7 @@ def run_filter(
     R: FloatArray,
     *,
     Q: FloatArray | None = None,
+    variant: str = DEFAULT_VARIANT,
 ) -> Predictions:
     """Run one of the scenario's filters on measurements z (B, N) with variances R (B, N).
 
@@ -568,12 +688,18 @@ def run_filter(
     ``stkf`` / ``stereo-stkf`` (and ``*-late``, one-step-late fading):
     :class:`seawatch.filters.StrongTrackingKalmanFilter` with β = 4.5, ρ = 0.95.
     All start from :func:`initial_state` at frame 0 (speed per
-    :meth:`FerryExperiment.initial_speed`) and share Q (default :func:`process_noise`).
+    :meth:`FerryExperiment.initial_speed`, the variant's P0 speed σ per
+    :func:`initial_speed_std`) and share Q (default :func:`process_noise`).
     """
     F, Q_default = process_noise()
     Qm = Q_default if Q is None else Q
     H = position_measurement(1, 2)
-    x0, P0 = initial_state(z[:, 0], R[:, 0], experiment.initial_speed(estimator))
+    x0, P0 = initial_state(
+        z[:, 0],
+        R[:, 0],
+        experiment.initial_speed(estimator),
+        initial_speed_std(experiment, variant),
+    )
     B, N = z.shape
     if estimator == "kf":
         kf = KalmanFilter(F, H, Qm, R[0, 0], x0, P0)
@@ -689,6 +815,15 @@ def _window_mask(N: int) -> NDArray[np.bool_]:
     return t <= VIDEO_WINDOW_S + 1e-9
 
 
+def _period_slices(N: int) -> list[slice]:
+    """Slices of the filtered frames 1…N−1 in each of :data:`FADING_PERIODS_S`."""
+    t = np.arange(1, N) * DT_S
+    return [
+        slice(int(np.searchsorted(t, a + 1e-9)), int(np.searchsorted(t, b + 1e-9)))
+        for _, a, b in FADING_PERIODS_S
+    ]
+
+
 @dataclass
 class FerryChunk:
     """What :func:`chunk` computes for one experiment and a chunk of runs.
@@ -703,6 +838,8 @@ class FerryChunk:
         nis_sum, nis_n, fading_sum, faded: per estimator, per-run sums over frames of
             the NIS and of the fading factor, frame counts and frames with fading > 1,
             each (B,).
+        faded_periods: per estimator, frames with fading > 1 in each of
+            :data:`FADING_PERIODS_S`, (B, 3).
     """
 
     runs: NDArray[np.int64]
@@ -713,6 +850,7 @@ class FerryChunk:
     nis_n: dict[str, NDArray[np.int64]]
     fading_sum: dict[str, FloatArray]
     faded: dict[str, NDArray[np.int64]]
+    faded_periods: dict[str, NDArray[np.int64]]
 
 
 def _chunk_experiment(
@@ -722,6 +860,7 @@ def _chunk_experiment(
     late_fading: bool,
     progress: Callable[[int], None] | None = None,
     block: int = CHUNK_RUNS,
+    variant: str = DEFAULT_VARIANT,
 ) -> FerryChunk:
     """Runs ``indices`` of one experiment, vectorised over blocks of ``block`` runs."""
     estimators = ESTIMATORS + (LATE_ESTIMATORS if late_fading else ())
@@ -734,8 +873,9 @@ def _chunk_experiment(
     tri: dict[tuple[str, str, int], list[tuple[FloatArray, NDArray[np.int64]]]] = {}
     sumsq: dict[tuple[str, str], list[FloatArray]] = {}
     diag: dict[str, dict[str, list[FloatArray]]] = {
-        k: {} for k in ("nis_sum", "nis_n", "fading_sum", "faded")
+        k: {} for k in ("nis_sum", "nis_n", "fading_sum", "faded", "faded_periods")
     }
+    periods = _period_slices(N)
     for lo in range(0, indices.size, block):
         runs = indices[lo : lo + block]
         gens = _generators(seed, experiment.number, runs.tolist())
@@ -758,7 +898,7 @@ def _chunk_experiment(
                 for metric, v in values.items():
                     tri.setdefault((metric, method, i), []).append((v, cnt))
         for est in estimators:
-            pred = run_filter(est, experiment, batch.z, batch.R)
+            pred = run_filter(est, experiment, batch.z, batch.R, variant=variant)
             errs = prediction_errors(batch, pred)
             for metric, e in errs.items():
                 e2 = e * e
@@ -771,6 +911,11 @@ def _chunk_experiment(
             diag["nis_n"].setdefault(est, []).append(np.full(runs.size, pred.nis.shape[1]))
             diag["fading_sum"].setdefault(est, []).append(np.sum(pred.fading, axis=1))
             diag["faded"].setdefault(est, []).append(np.count_nonzero(pred.fading > 1.0, axis=1))
+            diag["faded_periods"].setdefault(est, []).append(
+                np.stack(
+                    [np.count_nonzero(pred.fading[:, sl] > 1.0, axis=1) for sl in periods], axis=1
+                )
+            )
         if progress is not None:
             progress(runs.size)
     return FerryChunk(
@@ -852,6 +997,18 @@ def _merge_experiment(
             "fading_fraction": {
                 k: int(np.sum(cat(lambda p, k=k: p.faded[k]))) / max(n[k], 1) for k in estimators
             },
+            "fading_fraction_by_period": {
+                k: {
+                    name: (
+                        int(np.sum(cat(lambda p, k=k: p.faded_periods[k])[:, i]))
+                        / max(runs * (sl.stop - sl.start), 1)
+                    )
+                    for i, ((name, _, _), sl) in enumerate(
+                        zip(FADING_PERIODS_S, _period_slices(N), strict=True)
+                    )
+                }
+                for k in estimators
+            },
         },
     }
     return records, series
@@ -867,6 +1024,7 @@ def run_experiment(
     progress_offset: int = 0,
     progress_total: int | None = None,
     chunk: int = CHUNK_RUNS,
+    variant: str = DEFAULT_VARIANT,
 ) -> tuple[list[dict[str, Any]], dict[str, Any]]:
     """Monte-Carlo runs of one experiment, in blocks of ``chunk`` runs.
 
@@ -884,7 +1042,13 @@ def run_experiment(
             progress(done[0], total)
 
     payload = _chunk_experiment(
-        experiment, np.arange(runs), seed, late_fading, step, block=max(1, int(chunk))
+        experiment,
+        np.arange(runs),
+        seed,
+        late_fading,
+        step,
+        block=max(1, int(chunk)),
+        variant=_check_variant(variant),
     )
     return _merge_experiment(experiment, [payload], late_fading)
 
@@ -937,6 +1101,7 @@ def chunk(
     progress: ProgressCallback | None = None,
     experiment: int | None = None,
     late_fading: bool = False,
+    variant: str = DEFAULT_VARIANT,
 ) -> dict[int, FerryChunk]:
     """Runs ``indices`` of each experiment (the parallel protocol of
     :mod:`seawatch.scenarios.parallel`; :func:`run` is ``merge([chunk(range(runs))])``).
@@ -950,12 +1115,13 @@ def chunk(
         seed: seed of the per-run streams.
         progress: ``progress(done, total)`` after each block of runs (total = the
             chunk's runs × the number of experiments).
-        experiment, late_fading: as in :func:`run`.
+        experiment, late_fading, variant: as in :func:`run`.
 
     Returns:
         ``{experiment number: FerryChunk}``.
     """
     numbers = _numbers(experiment)
+    _check_variant(variant)
     idx = np.asarray(list(indices), dtype=np.int64)
     if idx.ndim != 1 or idx.size == 0 or idx[0] < 0 or np.any(np.diff(idx) <= 0):
         raise ValueError(f"indices: expected increasing non-negative run indices, got {indices!r}")
@@ -968,7 +1134,8 @@ def chunk(
             progress(done[0], total)
 
     return {
-        e: _chunk_experiment(EXPERIMENTS[e], idx, int(seed), late_fading, step) for e in numbers
+        e: _chunk_experiment(EXPERIMENTS[e], idx, int(seed), late_fading, step, variant=variant)
+        for e in numbers
     }
 
 
@@ -980,6 +1147,7 @@ def merge(
     *,
     experiment: int | None = None,
     late_fading: bool = False,
+    variant: str = DEFAULT_VARIANT,
 ) -> ExperimentResult:
     """The experiment JSON (and outputs) of :func:`run` from the chunks of :func:`chunk`.
 
@@ -988,9 +1156,10 @@ def merge(
         runs: the number of runs (checked against the chunks).
         seed: the seed the chunks were made with.
         out_dir: where ``table3.csv``, ``triangulation.csv`` and the plots go.
-        experiment, late_fading: the options the chunks were made with.
+        experiment, late_fading, variant: the options the chunks were made with.
     """
     numbers = _numbers(experiment)
+    _check_variant(variant)
     if not payloads:
         raise ValueError("payloads: expected at least one chunk")
     order = sorted(payloads, key=lambda p: int(p[numbers[0]].runs[0]))
@@ -1017,7 +1186,9 @@ def merge(
             for path in (
                 write_table3(records, out / "table3.csv"),
                 write_triangulation(records, out / "triangulation.csv"),
-                plot_prediction_errors(series, exp, out / f"prediction_error_exp{e}.png", n_runs),
+                plot_prediction_errors(
+                    series, exp, out / f"prediction_error_exp{e}.png", n_runs, variant
+                ),
             ):
                 if path not in outputs:
                     outputs.append(path)
@@ -1027,7 +1198,14 @@ def merge(
         int(seed),
         records,
         outputs=outputs,
-        extra={"ordering": order_ok, "diagnostics": diagnostics},
+        extra={
+            "variant": variant,
+            "initial_speed_std_mps": {
+                str(e): initial_speed_std(EXPERIMENTS[e], variant) for e in numbers
+            },
+            "ordering": order_ok,
+            "diagnostics": diagnostics,
+        },
     )
 
 
@@ -1038,6 +1216,7 @@ def run(
     progress: ProgressCallback | None = None,
     experiment: int | None = None,
     late_fading: bool = False,
+    variant: str = DEFAULT_VARIANT,
 ) -> ExperimentResult:
     """Run ``seawatch experiment stereo-ferry`` (SCENARIOS.md; seed 003 Table 3).
 
@@ -1055,17 +1234,23 @@ def run(
         experiment: 1 or 2 to run one experiment only (default: both).
         late_fading: also run the STKFs with the seed-literal one-step-late fading
             factor (estimators ``stkf-late``, ``stereo-stkf-late``; ablation).
+        variant: the shared P0 (:data:`VARIANTS`): ``"matched"`` (default, speed σ
+            0.1 m/s) or ``"stereo-prior"`` (speed σ = :func:`stereo_speed_std`, the
+            accuracy of the stereo-measured speed, trusted by all three filters);
+            ``seawatch experiment stereo-ferry --variant stereo-prior``.
 
     Returns:
         The experiment JSON (INTERFACES.md); ``extra`` holds ``"ordering"`` (for each
         experiment, over the whole run and the first 16 s: the three filters' means per
-        metric and whether KF > STKF > stereo + STKF holds) and ``"diagnostics"`` (per
-        experiment and filter: mean NIS, mean fading factor and the fraction of frames
-        with a fading factor > 1).
+        metric and whether KF > STKF > stereo + STKF holds), ``"diagnostics"`` (per
+        experiment and filter: mean NIS, mean fading factor, the fraction of frames
+        with a fading factor > 1, overall and per period of :data:`FADING_PERIODS_S`),
+        ``"variant"`` and ``"initial_speed_std_mps"`` (the P0 speed σ per experiment).
     """
     n_runs = _check_runs(runs)
-    opts = {"experiment": experiment, "late_fading": late_fading}
+    opts = {"experiment": experiment, "late_fading": late_fading, "variant": variant}
     _numbers(experiment)
+    _check_variant(variant)
     payload = chunk(range(n_runs), n_runs, seed, progress=progress, **opts)
     return merge([payload], n_runs, seed, out_dir, **opts)
 
@@ -1155,7 +1340,11 @@ _STYLE = {
 
 
 def plot_prediction_errors(
-    series: dict[str, Any], experiment: FerryExperiment, path: Path, runs: int
+    series: dict[str, Any],
+    experiment: FerryExperiment,
+    path: Path,
+    runs: int,
+    variant: str = DEFAULT_VARIANT,
 ) -> Path:
     """PNG: RMS over runs of each filter's one-step prediction error against time.
 
@@ -1202,8 +1391,8 @@ def plot_prediction_errors(
         ax.set_xlabel("time [s] (range 17.9 m → {:.0f} m)".format(series["range"][-1]))
     axes[0, 0].legend(fontsize=8)
     fig.suptitle(
-        f"stereo-ferry, experiment {experiment.number}: RMS one-step prediction error, "
-        f"{runs} runs (grey line: end of the 16-s video window)"
+        f"stereo-ferry ({variant}), experiment {experiment.number}: RMS one-step prediction "
+        f"error, {runs} runs (grey line: end of the 16-s video window)"
     )
     fig.savefig(path, dpi=100)
     return Path(path)
