@@ -6,7 +6,6 @@
   on frames; :class:`AnnotatedVideo` writes ``annotated.mp4`` (fragmented MP4).
 * :mod:`seawatch.report.html` — ``report.html``: self-contained (no network) plan view,
   range-vs-time plots, per-track table, error tables and the AIS cross-check.
-* :mod:`seawatch.report.air_range_plot` — range error against true range (``air-range``).
 """
 
 from seawatch.report.annotate import AnnotatedVideo, Annotator
