@@ -80,8 +80,9 @@ def test_air_range_records_do_not_depend_on_the_chunking():
     assert air_range.run(5, 11).records == whole.results
 
 
-def test_stereo_ferry_records_and_diagnostics_do_not_depend_on_the_chunking():
-    opts = {"experiment": 2}
+@pytest.mark.parametrize("variant", ["matched", "stereo-prior"])
+def test_stereo_ferry_records_and_diagnostics_do_not_depend_on_the_chunking(variant):
+    opts = {"experiment": 2, "variant": variant}
     whole = stereo_ferry.merge([stereo_ferry.chunk(range(4), 4, 2, **opts)], 4, 2, **opts)
     parts = [stereo_ferry.chunk(c, 4, 2, **opts) for c in (range(0, 1), range(1, 4))]
     split = stereo_ferry.merge(parts, 4, 2, **opts)
