@@ -273,6 +273,50 @@ def test_track_states_iterate_as_id_state_covariance_status():
     assert out.detection.tolist() == [0, 1]
 
 
+# ------------------------------------------------------------------ overlap stage
+def _growing_box(frames=30, jump=12):
+    """A box moving right 2 px/frame whose height jumps from 17 to 75 px at frame
+    ``jump`` with its bottom edge fixed (a hull that gains its superstructure): the
+    centre moves 29 px at once."""
+    out = []
+    for k in range(frames):
+        h = 17.0 if k < jump else 75.0
+        out.append(np.array([[100.0 + 2.0 * k, 300.0 - h, 60.0, h]]))
+    return out
+
+
+@pytest.mark.parametrize("factory", [None, AdaptiveFractionalKalmanFilter])
+def test_overlap_stage_keeps_the_id_of_a_re_segmented_box_and_restarts_its_centre(factory):
+    scans = _growing_box()
+    plain = _tracker(confirm_m=2, confirm_n=3)
+    ids_plain = {int(i) for z in scans for i in plain.step(z).confirmed_tracks().ids}
+    assert len(ids_plain) == 2  # the jump leaves the gate: a second track
+    trk = MultiTargetTracker(
+        factory, sigma_a=0.2, sigma_z=1.0, sigma_v0=5.0, confirm_m=2, confirm_n=3,
+        overlap_gate=0.5,
+    )  # fmt: skip
+    seen = set()
+    for z in scans:
+        st = trk.step(z)
+        seen |= {int(i) for i in st.confirmed_tracks().ids}
+    assert seen == {1}
+    # restarted at the new box: centre on the detection, size the detection's, and the
+    # velocity (2 px/frame to the right) kept
+    assert st.states[0, 0] == pytest.approx(100.0 + 2.0 * 29 + 30.0, abs=1.0)
+    assert st.states[0, 1] == pytest.approx(300.0 - 37.5, abs=1.0)
+    assert st.states[0, 2] == pytest.approx(2.0, abs=0.5)  # 17 frames after the restart
+    assert st.boxes[0, 3] == pytest.approx(75.0, abs=1.0)
+
+
+def test_overlap_stage_never_takes_a_detection_the_gate_paired_or_a_far_one():
+    trk = _tracker(confirm_m=1, confirm_n=1, overlap_gate=0.5)
+    trk.step(np.array([[0.0, 0.0, 10.0, 10.0], [100.0, 0.0, 10.0, 10.0]]))
+    # track 1 gets its own detection; a far box does not join track 2 (no overlap)
+    st = trk.step(np.array([[0.5, 0.0, 10.0, 10.0], [300.0, 0.0, 10.0, 10.0]]))
+    assert sorted(int(i) for i in st.ids) == [1, 2, 3]
+    assert st.detection.tolist() == [0, -1, 1]
+
+
 # ------------------------------------------------------------------ bad input
 
 
@@ -324,6 +368,8 @@ def test_non_increasing_times_raise_naming_time():
         ({"sigma_z": 0.0}, "sigma_z"),
         ({"dt": -1.0}, "dt"),
         ({"size_smoothing": 0.0}, "size_smoothing"),
+        ({"overlap_gate": 0.0}, "overlap_gate"),
+        ({"overlap_gate": 1.5}, "overlap_gate"),
         ({"filter_options": {"beta": 2.0}}, "filter_options"),
         ({"filter_factory": 3}, "filter_factory"),
         (

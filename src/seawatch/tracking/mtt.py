@@ -246,6 +246,14 @@ class MultiTargetTracker:
         delete_after: K, consecutive misses that delete a confirmed track (>= 1).
         size_smoothing: weight of a new box size in the exponential smoothing of
             (w, h), in (0, 1] (1: no smoothing).
+        overlap_gate: boxes only — a second association stage for what the gate left
+            unpaired: a track and a detection whose boxes overlap by at least this
+            fraction of the smaller box (intersection / smaller area, in (0, 1]) are
+            paired, largest overlap first, and the track is restarted at the detection
+            (centre and size; velocity and id kept) instead of updated. It keeps the id
+            of a ship whose box is re-segmented — a hull that gains its superstructure,
+            a bow that becomes a whole ship at the image edge — where the centre jumps
+            out of the gate. None (default): off.
         filter_options: extra keyword arguments for a filter class (see above).
     """
 
@@ -263,6 +271,7 @@ class MultiTargetTracker:
         confirm_n: int = 5,
         delete_after: int = 3,
         size_smoothing: float = 0.3,
+        overlap_gate: float | None = None,
         filter_options: dict[str, Any] | None = None,
     ) -> None:
         self.dt = positive("dt", dt)
@@ -282,6 +291,11 @@ class MultiTargetTracker:
             raise ValueError(f"confirm_n: expected <= 62, got {confirm_n}")
         self.delete_after = _count("delete_after", delete_after, 1)
         self.size_smoothing = in_range("size_smoothing", size_smoothing, 0.0, 1.0, lo_open=True)
+        self.overlap_gate = (
+            None
+            if overlap_gate is None
+            else in_range("overlap_gate", overlap_gate, 0.0, 1.0, lo_open=True)
+        )
         self.filter_options = dict(filter_options or {})
         self.H = position_measurement(_DIM, 2)
         self.R = self.sigma_z**2 * np.eye(_DIM)
@@ -425,6 +439,13 @@ class MultiTargetTracker:
         if sizes is not None and rows.size:
             s = self.size_smoothing
             self._size[rows] += s * (sizes[valid[cols]] - self._size[rows])
+        if sizes is not None and self.overlap_gate is not None:
+            r2, c2 = self._overlap_pairs(rows, cols, z, sizes[valid])
+            if r2.size:
+                self._restart(r2, z[c2], sizes[valid[c2]])
+                assigned[r2] = True
+                detection[r2] = valid[c2]
+                cols = np.concatenate([cols, c2])
         # 5. track management
         mask_n = (1 << self.confirm_n) - 1
         self._history = ((self._history << 1) | assigned) & mask_n
@@ -539,6 +560,51 @@ class MultiTargetTracker:
         gated = d2 <= self.gate
         rows, cols = rows[gated], cols[gated]
         return _assign_pairs(rows, cols, d2[gated] + np.log(detr[gated]))
+
+    def _overlap_pairs(
+        self, rows: NDArray[np.int64], cols: NDArray[np.int64], z: FloatArray, sizes: FloatArray
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        """Second stage (``overlap_gate``): unpaired tracks and detections whose boxes
+        overlap by at least the gate (intersection over the smaller area), greedily by
+        overlap. Track boxes are the predicted centres with the smoothed sizes."""
+        empty = np.empty(0, np.int64)
+        free_t = np.setdiff1d(np.arange(self.n_tracks), rows)
+        free_d = np.setdiff1d(np.arange(z.shape[0]), cols)
+        if free_t.size == 0 or free_d.size == 0:
+            return empty, empty
+        tc, ts = self._X[free_t, :_DIM], self._size[free_t]
+        dc, ds = z[free_d], sizes[free_d]
+        lo = np.maximum(tc[:, None] - 0.5 * ts[:, None], dc[None] - 0.5 * ds[None])
+        hi = np.minimum(tc[:, None] + 0.5 * ts[:, None], dc[None] + 0.5 * ds[None])
+        inter = np.prod(np.clip(hi - lo, 0.0, None), axis=2)
+        smaller = np.minimum(np.prod(ts, axis=1)[:, None], np.prod(ds, axis=1)[None])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ov = np.where(smaller > 0.0, inter / smaller, 0.0)
+        out_r, out_c = [], []
+        for flat in np.argsort(-ov, axis=None, kind="stable"):
+            i, j = divmod(int(flat), free_d.size)
+            if ov[i, j] < self.overlap_gate:
+                break
+            if free_t[i] in out_r or free_d[j] in out_c:
+                continue
+            out_r.append(int(free_t[i]))
+            out_c.append(int(free_d[j]))
+        return np.array(out_r, np.int64), np.array(out_c, np.int64)
+
+    def _restart(self, rows: NDArray[np.int64], z: FloatArray, sizes: FloatArray) -> None:
+        """Restart tracks ``rows`` at detections ``z`` with their velocity and id kept:
+        position σ_z, velocity covariance as it was (``overlap_gate``)."""
+        x0 = self._X[rows].copy()
+        x0[:, :_DIM] = z
+        P0 = np.broadcast_to(self.P0, (rows.size, _N, _N)).copy()
+        P0[:, _DIM:, _DIM:] = self._P[rows][:, _DIM:, _DIM:]
+        self._X[rows] = x0
+        self._P[rows] = P0
+        self._size[rows] = sizes
+        if self._factory is not None:
+            for i, r in enumerate(rows):
+                self._filters[int(r)] = self._factory(x0[i].copy(), P0[i].copy())
+            self._pull()
 
     def _update(self, rows: NDArray[np.int64], z: FloatArray) -> None:
         """Kalman update of the assigned tracks (Joseph form), predict-only for the rest."""

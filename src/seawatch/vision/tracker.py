@@ -96,6 +96,10 @@ class VisualTracker:
         delete_after: consecutive missed frames after which a confirmed track is
             dropped (the occlusion it survives by prediction).
         size_smoothing: weight of a new box size in the exponential smoothing, (0, 1].
+        overlap_gate: second association stage of the tracker (:class:`~seawatch.
+            tracking.mtt.MultiTargetTracker`): an unpaired track and detection whose boxes
+            overlap by this fraction of the smaller box continue the same id (a ship
+            entering at the image edge, a hull that gains its superstructure); None: off.
         min_score: detections with a lower score are ignored.
         horizon: estimate the horizon per frame and give it to the detector (sea region).
         fps: frame rate used when frames come without times [1/s].
@@ -120,6 +124,7 @@ class VisualTracker:
         confirm_n: int = 5,
         delete_after: int = 12,
         size_smoothing: float = 0.3,
+        overlap_gate: float | None = 0.5,
         min_score: float = 0.0,
         horizon: bool = True,
         fps: float = 25.0,
@@ -156,6 +161,7 @@ class VisualTracker:
             confirm_n=confirm_n,
             delete_after=delete_after,
             size_smoothing=size_smoothing,
+            overlap_gate=overlap_gate,
             filter_options=opts or None,
         )
         self._factory = factory
