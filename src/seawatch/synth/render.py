@@ -637,6 +637,7 @@ class Renderer:
         v_h = float(hline.v_at(canvas.cx))
         v0 = int(min(max(math.floor(v_h) + 1, 0), hc))
         self._v0 = v0
+        self._v_h = v_h
         u = (np.arange(wc, dtype=np.float64) - canvas.cx) / canvas.fx
         v = (np.arange(hc, dtype=np.float64) - canvas.cy) / canvas.fy
         R = canvas.R_pc
@@ -682,6 +683,8 @@ class Renderer:
             self._build_sea(rng, rgb, rf[v0:], rr[v0:], rd[v0:], az[v0:])
         ycc = _ycc(rgb).astype(np.float32)
         self._canvas_y = np.clip(np.rint(ycc[..., 0]), 0, 255).astype(np.uint8)
+        # the last sky row, untouched: the row holding the horizon is re-blended per frame
+        self._sky_row = self._canvas_y[max(v0 - 1, 0)].astype(np.float32)
         half = cv2.resize(ycc[..., 1:], (wc // 2, hc // 2), interpolation=cv2.INTER_AREA)
         self._canvas_u = np.clip(np.rint(half[..., 0]), 0, 255).astype(np.uint8)
         self._canvas_v = np.clip(np.rint(half[..., 1]), 0, 255).astype(np.uint8)
@@ -901,6 +904,24 @@ class Renderer:
             self._build_noise()
             self._background_ready = True
 
+    def _blend_horizon_row(self, y: NDArray) -> None:
+        """Anti-alias the sky/sea boundary of the level canvas: the pixel row holding the
+        horizon row ``v_h`` (row r covers [r − 0.5, r + 0.5]) gets the area-weighted mix
+        of the sky row above and the sea row below, so the painted edge is the geometric
+        horizon of horizon.csv to a fraction of a pixel (not the nearest row boundary)."""
+        v0 = self._v0
+        if not 0 < v0 < y.shape[0]:
+            return
+        f = v0 - 0.5 - self._v_h  # sea fraction of row v0 − 1 (> 0) or −sky fraction of row v0
+        if f > 0.0:
+            mix = (1.0 - f) * self._sky_row + f * y[v0].astype(np.float32)
+            y[v0 - 1] = np.clip(np.rint(mix), 0, 255).astype(np.uint8)
+        else:
+            y[v0 - 1] = np.rint(self._sky_row).astype(np.uint8)
+            if f < 0.0:
+                mix = (1.0 + f) * y[v0].astype(np.float32) - f * self._sky_row
+                y[v0] = np.clip(np.rint(mix), 0, 255).astype(np.uint8)
+
     def _paint_background(self, index: int, cam: PinholeCamera, buf: NDArray) -> None:
         self._ensure_background()
         w, h = cam.image_size
@@ -914,11 +935,13 @@ class Renderer:
             if has_sea:
                 self._sea_luma(t, y_plane[v0:])
             y_plane[:v0] = self._canvas_y[:v0]
+            self._blend_horizon_row(y_plane)
             np.copyto(u_plane, self._canvas_u)
             np.copyto(v_plane, self._canvas_v)
             return
         if has_sea:
             self._sea_luma(t, self._canvas_y[v0:])
+        self._blend_horizon_row(self._canvas_y)
         H = self._homography(self._canvas, cam)
         flags = cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP
         cv2.warpPerspective(
