@@ -295,11 +295,13 @@ def test_overlap_stage_keeps_the_id_of_a_re_segmented_box_and_restarts_its_centr
         factory, sigma_a=0.2, sigma_z=1.0, sigma_v0=5.0, confirm_m=2, confirm_n=3,
         overlap_gate=0.5,
     )  # fmt: skip
-    seen = set()
-    for z in scans:
+    seen, restarts = set(), []
+    for k, z in enumerate(scans):
         st = trk.step(z)
         seen |= {int(i) for i in st.confirmed_tracks().ids}
-    assert seen == {1}
+        if st.restarted is not None and st.restarted.any():
+            restarts.append(k)
+    assert seen == {1} and restarts == [12]  # flagged once, at the jump
     # restarted at the new box: centre on the detection, size the detection's, and the
     # velocity (2 px/frame to the right) kept
     assert st.states[0, 0] == pytest.approx(100.0 + 2.0 * 29 + 30.0, abs=1.0)

@@ -103,6 +103,8 @@ class TrackStates:
             that updated or started the track, -1 if none, (k,) int64.
         boxes: smoothed boxes ``(x, y, w, h)`` around the estimated centre, (k, 4), in
             px; ``None`` when the detections are points.
+        restarted: True where this scan restarted the track at an overlapping detection
+            (``overlap_gate``), (k,); None: all False.
     """
 
     time: float
@@ -114,6 +116,7 @@ class TrackStates:
     hits: NDArray[np.int64]
     detection: NDArray[np.int64]
     boxes: FloatArray | None = None
+    restarted: NDArray[np.bool_] | None = None
 
     def __len__(self) -> int:
         return int(self.ids.shape[0])
@@ -147,6 +150,7 @@ class TrackStates:
             hits=self.hits[mask],
             detection=self.detection[mask],
             boxes=None if self.boxes is None else self.boxes[mask],
+            restarted=None if self.restarted is None else self.restarted[mask],
         )
 
     def confirmed_tracks(self) -> TrackStates:
@@ -436,12 +440,14 @@ class MultiTargetTracker:
         self._update(rows, z[cols])
         detection = np.full(self.n_tracks, -1, np.int64)
         detection[rows] = valid[cols]
+        restarted = np.zeros(self.n_tracks, bool)
         if sizes is not None and rows.size:
             s = self.size_smoothing
             self._size[rows] += s * (sizes[valid[cols]] - self._size[rows])
         if sizes is not None and self.overlap_gate is not None:
             r2, c2 = self._overlap_pairs(rows, cols, z, sizes[valid])
             if r2.size:
+                restarted[r2] = True
                 self._restart(r2, z[c2], sizes[valid[c2]])
                 assigned[r2] = True
                 detection[r2] = valid[c2]
@@ -459,13 +465,15 @@ class MultiTargetTracker:
         keep = np.where(self._confirmed, self._misses < self.delete_after, can_confirm)
         self._compress(keep)
         detection = detection[keep]
+        restarted = restarted[keep]
         free = np.ones(valid.size, bool)
         free[cols] = False
         births = valid[free]
         self._birth(centres[births], None if sizes is None else sizes[births])
         detection = np.concatenate([detection, births.astype(np.int64)])
+        restarted = np.concatenate([restarted, np.zeros(births.size, bool)])
         self._time = t
-        return self._report(t, detection)
+        return self._report(t, detection, restarted)
 
     def run(
         self, scans: Sequence[ArrayLike | None], times: ArrayLike | None = None
@@ -668,7 +676,9 @@ class MultiTargetTracker:
         size = np.zeros((k, 2)) if sizes is None else sizes
         self._size = np.concatenate([self._size, size])
 
-    def _report(self, t: float, detection: NDArray[np.int64]) -> TrackStates:
+    def _report(
+        self, t: float, detection: NDArray[np.int64], restarted: NDArray[np.bool_] | None = None
+    ) -> TrackStates:
         boxes = None
         if self._boxes:
             boxes = np.concatenate([self._X[:, :_DIM] - 0.5 * self._size, self._size], axis=1)
@@ -682,6 +692,7 @@ class MultiTargetTracker:
             hits=self._hits.copy(),
             detection=detection,
             boxes=boxes,
+            restarted=restarted,
         )
 
 

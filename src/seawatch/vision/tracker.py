@@ -259,6 +259,8 @@ class VisualTracker:
             if not np.all(np.isfinite(off)):
                 continue
             prev = self._offsets.get(tid)
+            if st.restarted is not None and st.restarted[i]:
+                prev = None  # a re-segmented box: its own water-line offset from now on
             self._offsets[tid] = off if prev is None else prev + self._smooth * (off - prev)
         sel = np.flatnonzero(st.confirmed)
         out = np.empty((sel.size, len(TRACK_COLUMNS)))
