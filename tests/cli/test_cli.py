@@ -4,6 +4,7 @@ document on stdout with --json, exit codes 0 / 1 / 2."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 import typer
@@ -87,7 +88,10 @@ def test_experiment_json_has_the_interfaces_shape(tmp_path):
     assert (doc["scenario"], doc["runs"], doc["seed"]) == ("air-range", 2, 4)
     keys = {"estimator", "metric", "unit", "mean", "stderr", "paper", "params"}
     assert all(keys <= set(r) for r in doc["results"])
-    assert len(doc["outputs"]) == 2
+    # errors.csv, range_error.png and the paper's Figs. 3-6
+    names = {Path(p).name for p in doc["outputs"]}
+    assert {"errors.csv", "range_error.png"} <= names and len(names) == 6
+    assert all(Path(p).is_file() for p in doc["outputs"])
 
 
 @pytest.mark.parametrize(
