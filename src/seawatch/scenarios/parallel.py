@@ -428,8 +428,12 @@ def run_experiment(
             w = 1  # too small to pay for a cluster
         chunks = _plan(mod, units, runs, options, TASKS_PER_WORKER * w, chunk)
         if w == 1 or len(chunks) == 1:
-            return _in_process(mod, chunks if chunk else None, units, runs, seed, out_dir,
-                               progress, options)  # fmt: skip
+            if not chunk:  # one process, one chunk: the scenario's own run(), which may
+                # write more as it goes (ship-video keeps its footage)
+                return registry.runner(name)(
+                    runs=runs, seed=seed, out_dir=out_dir, progress=progress, **options
+                )
+            return _in_process(mod, chunks, units, runs, seed, out_dir, progress, options)
         with _local_client(w) as client:
             return _on_cluster(mod, name, client, chunks, runs, seed, out_dir, progress, options)
     with _remote_client(scheduler, timeout) as client:
@@ -440,7 +444,7 @@ def run_experiment(
 
 def _in_process(
     mod: ModuleType,
-    chunks: list[range] | None,
+    chunks: list[range],
     units: int,
     runs: int | None,
     seed: int,
@@ -448,14 +452,11 @@ def _in_process(
     progress: ProgressCallback | None,
     options: dict[str, Any],
 ) -> ExperimentResult:
-    if chunks is None:  # one chunk, the scenario's own progress: exactly run()
-        payloads = [mod.chunk(range(units), runs, seed, progress=progress, **options)]
-    else:
-        payloads = []
-        for i, c in enumerate(chunks, start=1):
-            payloads.append(mod.chunk(c, runs, seed, **options))
-            if progress is not None:
-                progress(i, len(chunks))
+    payloads = []
+    for i, c in enumerate(chunks, start=1):
+        payloads.append(mod.chunk(c, runs, seed, **options))
+        if progress is not None:
+            progress(i, len(chunks))
     return mod.merge(payloads, runs, seed, out_dir, **options)
 
 
