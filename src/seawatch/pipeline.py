@@ -532,14 +532,16 @@ def track_video(
                     for i, rec in enumerate(records):
                         rec["azimuth_deg"] = math.degrees(float(az[i]))
                         rec["depression_deg"] = math.degrees(float(dep[i]))
-                        rec["estimator"] = estimator
-                        rec.update(_estimate_cells(best, i))
                     est_rows = [
                         {**rec, "estimator": name, **_estimate_cells(est, i)}
                         for name, est in estimates.items()
                         for i, rec in enumerate(records)
                     ]
-                    _add_geodetic(records + est_rows, lat0, lon0)
+                    _add_geodetic(est_rows, lat0, lon0)
+                    # tracks.csv rows are the chosen estimator's rows of estimates.csv
+                    first = list(estimates).index(estimator) * len(records)
+                    for i, rec in enumerate(records):
+                        rec.update(est_rows[first + i])
                     for row in est_rows:
                         est_out.write(row)  # type: ignore[union-attr]
                     if associator is not None and frames % ais_every == 0:
