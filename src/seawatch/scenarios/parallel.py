@@ -433,7 +433,7 @@ def run_experiment(
                 return registry.runner(name)(
                     runs=runs, seed=seed, out_dir=out_dir, progress=progress, **options
                 )
-            return _in_process(mod, chunks, units, runs, seed, out_dir, progress, options)
+            return _in_process(mod, chunks, runs, seed, out_dir, progress, options)
         with _local_client(w) as client:
             return _on_cluster(mod, name, client, chunks, runs, seed, out_dir, progress, options)
     with _remote_client(scheduler, timeout) as client:
@@ -445,7 +445,6 @@ def run_experiment(
 def _in_process(
     mod: ModuleType,
     chunks: list[range],
-    units: int,
     runs: int | None,
     seed: int,
     out_dir: str | Path | None,

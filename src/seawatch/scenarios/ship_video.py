@@ -121,13 +121,36 @@ def unit_costs(
     return np.tile(np.array(one), _runs(runs))
 
 
+def _unit_options(
+    width: int,
+    height: int,
+    duration: float,
+    orders: Sequence[float],
+    small_scale: int,
+    fps: float,
+) -> dict[str, Any]:
+    """The rendering and sweep options of :func:`_unit`, checked."""
+    return {
+        "width": width,
+        "height": height,
+        "duration": duration,
+        "orders": _orders(orders),
+        "small_scale": small_scale,
+        "fps": fps,
+    }
+
+
+def _case(u: int, names: list[str]) -> tuple[int, str]:
+    """Unit ``u`` is run ``u // len(names)`` of case ``names[u % len(names)]``."""
+    r, i = divmod(u, len(names))
+    return r, names[i]
+
+
 def _unit(
     u: int,
     names: list[str],
     seed: int,
-    root: Path,
-    keep_folder: bool,
-    runs: int,
+    folder: Path,
     width: int,
     height: int,
     duration: float,
@@ -135,13 +158,11 @@ def _unit(
     small_scale: int,
     fps: float,
 ) -> dict[str, Any]:
-    """Render, detect and track unit ``u`` (run ``u // len(names)``, case
-    ``names[u % len(names)]``); rows ``(estimator, order, cle_px, cle_percent,
-    precision)`` with order None except in the sweep."""
-    r, i = divmod(u, len(names))
-    name = names[i]
+    """Render (into ``folder``), detect and track unit ``u`` (:func:`_case`); rows
+    ``(estimator, order, cle_px, cle_percent, precision)`` with order None except in the
+    sweep."""
+    r, name = _case(u, names)
     k = small_scale if name == SWEEP_CASE else 1
-    folder = root / (name if runs == 1 or not keep_folder else f"{name}-{r}")
     res = render_case(
         name, folder, duration=duration, fps=fps, width=width * k, height=height * k, seed=seed + r
     )
@@ -204,15 +225,7 @@ def run(
     """
     n_runs = _runs(runs)
     names = _names(cases)
-    alphas = _orders(orders)
-    opts = {
-        "width": width,
-        "height": height,
-        "duration": duration,
-        "orders": alphas,
-        "small_scale": small_scale,
-        "fps": fps,
-    }
+    opts = _unit_options(width, height, duration, orders, small_scale, fps)
     with contextlib.ExitStack() as stack:
         if out_dir is None:
             root = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="seawatch-sv-")))
@@ -226,7 +239,9 @@ def run(
         done: list[dict[str, Any]] = []
         total = n_runs * len(names)
         for u in range(total):
-            done.append(_unit(u, names, seed, root, True, n_runs, **opts))
+            r, name = _case(u, names)
+            folder = root / (name if n_runs == 1 else f"{name}-{r}")
+            done.append(_unit(u, names, seed, folder, **opts))
             if tw is not None:
                 tw.writerows(_csv_rows(done[-1]))
                 table.flush()
@@ -254,14 +269,7 @@ def chunk(
     temporary folder (the parallel protocol of :mod:`seawatch.scenarios.parallel`); a
     unit's numbers depend only on (seed, run, case)."""
     names = _names(cases)
-    opts = {
-        "width": width,
-        "height": height,
-        "duration": duration,
-        "orders": _orders(orders),
-        "small_scale": small_scale,
-        "fps": fps,
-    }
+    opts = _unit_options(width, height, duration, orders, small_scale, fps)
     idx = [int(i) for i in indices]
     n = _runs(runs) * len(names)
     if not idx or idx != sorted(set(idx)) or idx[0] < 0 or idx[-1] >= n:
@@ -269,7 +277,7 @@ def chunk(
     out = []
     with tempfile.TemporaryDirectory(prefix="seawatch-sv-") as tmp:
         for u in idx:
-            out.append(_unit(u, names, seed, Path(tmp) / str(u), False, runs, **opts))
+            out.append(_unit(u, names, seed, Path(tmp) / str(u), **opts))
             if progress is not None:
                 progress(len(out), len(idx))
     return out

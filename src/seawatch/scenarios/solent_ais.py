@@ -1031,14 +1031,18 @@ def run(
         "vessels": vessels,
     }
     n_runs = _runs(runs)
+    _seed(seed)
     if out_dir is not None:  # an unwritable folder fails before any work
         Path(out_dir).mkdir(parents=True, exist_ok=True)
-    payload = chunk(range(n_runs), n_runs, seed, progress=progress, **options)
-    return merge([payload], n_runs, seed, out_dir, **options)
+    scene = _scene(options)  # built once for both halves of the protocol
+    payload = _chunk(scene, range(n_runs), seed, progress)
+    return _merge(scene, [payload], n_runs, seed, out_dir)
 
 
 def _scene(options: dict[str, Any]) -> Scene:
-    return build_scene(options.pop("ais", None), **options)
+    """The scene of :func:`run`'s scene options (``ais`` and the camera options)."""
+    opts = dict(options)
+    return build_scene(opts.pop("ais", None), **opts)
 
 
 def chunk(
@@ -1069,11 +1073,16 @@ def chunk(
         metric), the block sums and counts of squared position errors per sample, and
         for the block holding run 0 the geometry and EKF estimates (the plan view).
     """
+    return _chunk(_scene(options), indices, seed, progress)
+
+
+def _chunk(
+    scene: Scene, indices: Sequence[int], seed: int, progress: ProgressCallback | None
+) -> dict[str, Any]:
     idx = [int(i) for i in indices]
     if not idx or min(idx) < 0 or idx != sorted(set(idx)):
         raise ValueError(f"indices: expected increasing non-negative run indices, got {indices!r}")
     s = _seed(seed)
-    scene = _scene(dict(options))
     blocks: dict[int, list[int]] = {}
     for i in idx:
         blocks.setdefault(i // CHUNK, []).append(i)
@@ -1115,12 +1124,21 @@ def merge(
     """The experiment's records (and outputs in ``out_dir``) from the payloads of
     :func:`chunk`, given in run order (the parallel protocol of
     :mod:`seawatch.scenarios.parallel`)."""
+    return _merge(_scene(options), payloads, runs, seed, out_dir)
+
+
+def _merge(
+    scene: Scene,
+    payloads: Sequence[dict[str, Any]],
+    runs: int | None,
+    seed: int,
+    out_dir: str | Path | None,
+) -> ExperimentResult:
     s = _seed(seed)
     got = [i for p in payloads for i in p["runs"]]
     n_runs = len(got)
     if got != list(range(n_runs)) or (runs is not None and n_runs != runs):
         raise ValueError(f"payloads: expected runs 0 … {(runs or n_runs) - 1} in order")
-    scene = _scene(dict(options))
     out = Path(out_dir) if out_dir is not None else None
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
