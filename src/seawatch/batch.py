@@ -122,6 +122,8 @@ def track_batch(
         ValueError: no source, an unwritable ``out_dir`` or a missing camera file (before
             any work); SchedulerError (a ValueError) when the scheduler does not answer.
     """
+    from seawatch.report.geojson import atomic_write_text
+
     srcs = [str(s) for s in sources]
     if not srcs:
         raise ValueError("SOURCES: expected at least one video, folder or stream")
@@ -141,9 +143,7 @@ def track_batch(
         results[i] = value
         items = _items(srcs, folders, results)
         text = json.dumps(BatchResult(items, summary_path).to_json(), indent=1)
-        tmp = summary_path.with_suffix(".json.tmp")
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, summary_path)
+        atomic_write_text(summary_path, text)
         if progress is not None:
             progress(done, len(srcs))
 

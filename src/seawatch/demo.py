@@ -60,7 +60,6 @@ class DemoRun:
 def _settings() -> dict[str, Any]:
     from seawatch.io.camera_file import camera_to_dict
     from seawatch.synth.ais_scene import DEMO, demo_camera
-
     return {
         "camera": camera_to_dict(demo_camera()),
         "start": DEMO.start,
@@ -106,9 +105,10 @@ def run_demo(out_dir: str | Path, *, progress: Progress | None = None) -> DemoRu
         and (clip / "truth.csv").is_file()
         and json.loads(stamp.read_text(encoding="utf-8")) == json.loads(json.dumps(settings))
     )
+    ais = read_ais(ais_path)  # once, for the rendering and the cross-check
     if not fresh:
         render_ais(
-            ais_path,
+            ais,
             camera,
             out_dir=clip,
             start=DEMO.start,
@@ -126,7 +126,7 @@ def run_demo(out_dir: str | Path, *, progress: Progress | None = None) -> DemoRu
         clip / "video.mp4",
         out,
         camera=camera,
-        ais=read_ais(ais_path),
+        ais=ais,
         truth=clip / "truth.csv",
         start=DEMO.start,
         progress=None if progress is None else lambda d, t: progress("track", d, t),
