@@ -913,14 +913,12 @@ class Renderer:
         if not 0 < v0 < y.shape[0]:
             return
         f = v0 - 0.5 - self._v_h  # sea fraction of row v0 − 1 (> 0) or −sky fraction of row v0
-        if f > 0.0:
+        if f > 0.0:  # f is fixed per clip: row v0 − 1 is rewritten from the kept sky row
             mix = (1.0 - f) * self._sky_row + f * y[v0].astype(np.float32)
             y[v0 - 1] = np.clip(np.rint(mix), 0, 255).astype(np.uint8)
-        else:
-            y[v0 - 1] = np.rint(self._sky_row).astype(np.uint8)
-            if f < 0.0:
-                mix = (1.0 + f) * y[v0].astype(np.float32) - f * self._sky_row
-                y[v0] = np.clip(np.rint(mix), 0, 255).astype(np.uint8)
+        elif f < 0.0:  # row v0 is repainted with sea every frame
+            mix = (1.0 + f) * y[v0].astype(np.float32) - f * self._sky_row
+            y[v0] = np.clip(np.rint(mix), 0, 255).astype(np.uint8)
 
     def _paint_background(self, index: int, cam: PinholeCamera, buf: NDArray) -> None:
         self._ensure_background()
