@@ -60,6 +60,8 @@ class DemoRun:
 def _settings() -> dict[str, Any]:
     from seawatch.io.camera_file import camera_to_dict
     from seawatch.synth.ais_scene import DEMO, demo_camera
+    from seawatch.synth.render import RENDER_VERSION
+
     return {
         "camera": camera_to_dict(demo_camera()),
         "start": DEMO.start,
@@ -69,6 +71,7 @@ def _settings() -> dict[str, Any]:
         "seed": DEMO.seed,
         "coastline": DEMO.coastline,
         "sway": list(DEMO.sway) if DEMO.sway else None,
+        "renderer": RENDER_VERSION,
     }
 
 

@@ -54,6 +54,7 @@ from typing import Any
 import numpy as np
 
 from seawatch._validation import FloatArray
+from seawatch.synth.render import RENDER_VERSION
 
 __all__ = [
     "CLE_PERCENT_MAX",
@@ -154,7 +155,7 @@ def scene(duration: float) -> list[Any]:
 
 
 def _default_folder(frames: int, width: int, height: int, fps: float, seed: int) -> Path:
-    name = f"{width}x{height}-{frames}f-{fps:g}fps-s{seed}-v{SCENE_VERSION}"
+    name = f"{width}x{height}-{frames}f-{fps:g}fps-s{seed}-v{SCENE_VERSION}.{RENDER_VERSION}"
     return Path(tempfile.gettempdir()) / "seawatch-bench-video" / name
 
 
@@ -186,7 +187,7 @@ def render_clip(
         raise ValueError(f"fps: expected a positive frame rate, got {fps!r}")
     out = Path(folder) if folder is not None else _default_folder(frames, width, height, fps, seed)
     done = out / "bench-video.done"
-    key = f"{frames} {width} {height} {fps!r} {seed} v{SCENE_VERSION}"
+    key = f"{frames} {width} {height} {fps!r} {seed} v{SCENE_VERSION}.{RENDER_VERSION}"
     if done.is_file() and done.read_text(encoding="utf-8").strip() == key:
         return Clip(out, frames, width, height, float(fps), 0.0)
     from seawatch.synth.cases import case_camera

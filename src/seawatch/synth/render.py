@@ -86,6 +86,7 @@ from seawatch.synth.world import Ship
 __all__ = [
     "HORIZON_COLUMNS",
     "LIGHTINGS",
+    "RENDER_VERSION",
     "TRUTH_COLUMNS",
     "Lighting",
     "ObjectTruth",
@@ -96,6 +97,11 @@ __all__ = [
     "render",
     "sway_attitude",
 ]
+
+RENDER_VERSION = 2
+"""Changes whenever the renderer paints different pixels for the same scene (2: the
+horizon row is an area-weighted sky/sea mix), so that clips cached by the benchmark and
+the demo are rendered again rather than reused."""
 
 RGB = tuple[float, float, float]
 Earth = Literal["flat", "curved"]
