@@ -66,7 +66,7 @@ from seawatch.geometry import horizon_distance
 from seawatch.geometry.sea import effective_radius
 from seawatch.io.ais import MAX_GAP, AisTable, AisTrack, interpolate_track, read_ais, tracks
 from seawatch.synth.render import Lighting, RenderResult, render
-from seawatch.synth.world import KINDS, Ship, make_ship, ships_from_tracks
+from seawatch.synth.world import KINDS, Ship, kind_for_length, make_ship, ships_from_tracks
 
 __all__ = [
     "DEFAULT_DURATION",
@@ -285,9 +285,9 @@ def vessel_size(
             kind = tc[0] if tc is not None else None
         if kind is not None and kind not in KINDS:
             raise ValueError(f"sizes[{track.mmsi}]: kind must be one of {KINDS}, got {kind!r}")
-        return VesselSize(track.mmsi, kind or _kind_by_length(length), length, None, "given", speed)
+        return VesselSize(track.mmsi, kind or kind_for_length(length), length, None, "given", speed)
     if static is not None and math.isfinite(static.length):
-        kind = tc[0] if tc is not None else _kind_by_length(static.length)
+        kind = tc[0] if tc is not None else kind_for_length(static.length)
         return VesselSize(track.mmsi, kind, static.length, beam, "ais", speed)
     if tc is not None:
         return VesselSize(track.mmsi, tc[0], tc[1], beam, "type", speed)
@@ -296,15 +296,6 @@ def vessel_size(
         if v >= least:
             return VesselSize(track.mmsi, kind, length, None, "speed", speed)
     raise AssertionError("SPEED_CLASSES must end with a 0 m/s class")  # pragma: no cover
-
-
-def _kind_by_length(length: float) -> str:
-    # make_ship's own default by length
-    if length < 15.0:
-        return "boat"
-    if length < 60.0:
-        return "workboat"
-    return "cargo"
 
 
 # ----------------------------------------------------------------------------- geometry

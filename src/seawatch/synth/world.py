@@ -40,6 +40,7 @@ __all__ = [
     "Trajectory",
     "crossing",
     "hull_prism",
+    "kind_for_length",
     "make_ship",
     "meeting",
     "overtaking",
@@ -554,7 +555,9 @@ _WHITE: RGB = (226.0, 226.0, 218.0)
 _CREAM: RGB = (212.0, 204.0, 180.0)
 
 
-def _default_kind(length: float) -> str:
+def kind_for_length(length: float) -> str:
+    """The ship kind :func:`make_ship` draws for a hull of ``length`` [m] when none is
+    given: boat under 15 m, workboat under 60 m, cargo beyond."""
     if length < 15.0:
         return "boat"
     if length < 60.0:
@@ -587,7 +590,7 @@ def make_ship(
     every render.
     """
     L = positive("length", length)
-    kind = _default_kind(L) if kind is None else kind
+    kind = kind_for_length(L) if kind is None else kind
     if kind not in KINDS:
         raise ValueError(f"kind: expected one of {', '.join(KINDS)}, got {kind!r}")
     rng = np.random.default_rng(abs(int(object_id if seed is None else seed)) % (2**32))
