@@ -140,6 +140,32 @@ def test_air_range_information_is_inverse_size_range_variance():
     assert res.information.shape == (2, 3, 3)
 
 
+def test_per_step_process_noise_equals_the_recursion_written_out():
+    """Q (T, n, n): Q[k] drives the prediction into step k — against information_predict
+    step by step, and a constant stack equals the single Q."""
+    rng = np.random.default_rng(1234)
+    d = rng.uniform(2000.0, 5000.0, 30)
+    sig = rng.uniform(0.0, 0.5, 30)
+    res = crlb.air_range_pcrb(d, 0.04, "nca", sig, predict_first=False)
+    F, Q1 = constant_acceleration(1, 0.04, 1.0)
+    J = np.zeros((3, 3))
+    for k in range(d.size):
+        if k:
+            J = crlb.information_predict(J, F, sig[k] ** 2 * Q1)
+        J = J + np.diag([(40_000.0 * 10.0 / d[k] ** 2) ** 2, 0.0, 0.0])
+        np.testing.assert_allclose(res.information[k], J, rtol=1e-10, atol=1e-18)
+    same = crlb.air_range_pcrb(d, 0.04, "nca", np.full(30, 0.3), predict_first=False)
+    np.testing.assert_allclose(
+        same.information,
+        crlb.air_range_pcrb(d, 0.04, "nca", 0.3, predict_first=False).information,
+        rtol=1e-12,
+    )
+    with pytest.raises(ValueError, match="sigma"):
+        crlb.air_range_pcrb(d, 0.04, "nca", sig[:5])
+    with pytest.raises(ValueError, match="Q"):
+        crlb.pcrb_information(F, np.stack([Q1] * 4), np.zeros((5, 3, 3)), J0=np.zeros((3, 3)))
+
+
 # ------------------------------------------------------------------ nonlinear measurement
 def test_measurement_information_averages_over_sampled_trajectories():
     rng = np.random.default_rng(1234)

@@ -222,7 +222,9 @@ def pcrb_information(
 
     Args:
         F: transition matrix (n, n), invertible.
-        Q: process noise covariance (n, n), PSD (may be singular or zero).
+        Q: process noise covariance (n, n), PSD (may be singular or zero); or (T, n, n),
+            one per step: ``Q[k]`` drives the prediction into step k (``Q[0]`` is unused
+            with ``predict_first=False``).
         measurement_info: I_k = E[H_kᵀ R_k⁻¹ H_k], (T, n, n), PSD; a zero block is a step
             without a measurement.
         P0: prior covariance (n, n), positive definite; or
@@ -234,18 +236,21 @@ def pcrb_information(
     """
     F = _transition("F", F)
     n = F.shape[0]
-    Q = covariance("Q", Q, n)
+    varying = np.ndim(Q) == 3
+    Q = covariance("Q", Q, n, batch=varying)
     info = finite("measurement_info", as_float_array("measurement_info", measurement_info))
     if info.ndim != 3 or info.shape[1:] != (n, n):
         raise ValueError(f"measurement_info: expected shape (T, {n}, {n}), got {info.shape}")
+    T = info.shape[0]
+    if varying and Q.shape[0] != T:
+        raise ValueError(f"Q: expected one covariance per step, ({T}, {n}, {n}), got {Q.shape}")
     J = _initial_information(P0, J0, n)
     Finv = np.linalg.inv(F)
-    M = _sym(Finv @ Q @ Finv.T)
-    T = info.shape[0]
+    M = _sym(Finv @ Q @ Finv.T)  # (n, n) or (T, n, n)
     out = np.empty((T, n, n))
     for k in range(T):
         if predict_first or k > 0:
-            J = _predict(J, Finv, M)
+            J = _predict(J, Finv, M[k] if varying else M)
         J = _sym(J + info[k])
         out[k] = J
     return PCRBResult(information=out, bound=_inverse_or_inf(out))
@@ -595,7 +600,9 @@ def air_range_pcrb(
         true_range: true range per frame [m], (T,) or (S, T) (averaged over samples).
         dt: frame period [s].
         model: "ncv" or "nca".
-        sigma: process-noise level of the model [m/s²].
+        sigma: process-noise level of the model [m/s²]; or (T,) levels, one per frame
+            (``sigma[k]`` drives the prediction into frame k, as ``Q`` of
+            :func:`pcrb_information`).
         sigma_l, focal, size: image-size noise [px], focal length [px], target size [m].
         P0 / J0: prior (exactly one; default J0 = 0, diffuse).
         predict_first: timing convention (module docstring).
@@ -609,11 +616,15 @@ def air_range_pcrb(
             f"true_range: expected positive ranges, shape (T,) or (S, T), got {d.shape}"
         )
     if model == "ncv":
-        F, Q = constant_velocity(1, dt, sigma, noise=noise)
+        F, Q = constant_velocity(1, dt, 1.0, noise=noise)
     elif model == "nca":
-        F, Q = constant_acceleration(1, dt, sigma, noise=noise)
+        F, Q = constant_acceleration(1, dt, 1.0, noise=noise)
     else:
         raise ValueError(f"model: expected 'ncv' or 'nca', got {model!r}")
+    s = finite("sigma", as_float_array("sigma", sigma))
+    if s.ndim > 1 or np.any(s < 0.0) or (s.ndim == 1 and s.shape[0] != d.shape[-1]):
+        raise ValueError(f"sigma: expected a level >= 0 or one per frame ({d.shape[-1]},)")
+    Q = s[..., None, None] ** 2 * Q  # Q scales with σ² (§5.2)
     n = F.shape[0]
     fL = positive("focal", focal) * positive("size", size)
     sl = positive("sigma_l", sigma_l)

@@ -50,7 +50,7 @@ The bound (``crlb``)
 --------------------
 :func:`pcrb`: the posterior Cramér–Rao bound of the range (ALGORITHMS.md §7,
 Tichavský recursion in the singular-Q form; :func:`seawatch.metrics.crlb.
-information_predict` per step) with the state ``[d, ḋ, d̈]`` and the NCA (DWPA)
+air_range_pcrb` with one process-noise level per frame) with the state ``[d, ḋ, d̈]`` and the NCA (DWPA)
 dynamics of §5.2, whose process noise is the **truth's own motion**: the
 acceleration increment of frame k → k+1 has standard deviation ``Δa_k = |d̈(t_{k+1}) −
 d̈(t_k)|`` (0.002–0.024 m/s² per frame in the level flight, 3.7 m/s² at the onset of
@@ -157,7 +157,7 @@ from seawatch.filters.adaptive_range import (
     AdaptiveRangeFilter,
     size_range_std,
 )
-from seawatch.metrics.crlb import PCRBResult, information_predict
+from seawatch.metrics.crlb import PCRBResult, air_range_pcrb
 from seawatch.models.kinematic import constant_acceleration, constant_velocity
 from seawatch.scenarios.base import ExperimentResult, record
 
@@ -503,24 +503,15 @@ def pcrb(
         PCRBResult over the N frames; ``rmse_bound(0)`` is the least RMS range error [m].
     """
     truth = trajectory() if truth is None else truth
-    d = truth.range
-    fL = positive("focal", focal) * positive("size", size)
-    sl = positive("sigma_l", sigma_l)
-    info_d = (fL / (d * d)) ** 2 / (sl * sl)  # 1/σ_d² [1/m²]
-    F, Qu = constant_acceleration(1, truth.dt, 1.0)  # Q_k = Δa_k² Γ Γᵀ
-    steps = np.abs(np.diff(truth.range_acceleration))
+    # Δa_k drives the prediction into frame k (frame 0 has none)
+    steps = np.concatenate([[0.0], np.abs(np.diff(truth.range_acceleration))])
     s_rate = max(abs(float(truth.range_rate[0])), PRIOR_FLOOR)
     s_acc = max(abs(float(truth.range_acceleration[0])), PRIOR_FLOOR)
-    J = np.diag([0.0, 1.0 / s_rate**2, 1.0 / s_acc**2])
-    out = np.empty((d.size, 3, 3))
-    for k in range(d.size):
-        if k:
-            J = information_predict(J, F, steps[k - 1] ** 2 * Qu)
-        J = J.copy()
-        J[0, 0] += info_d[k]
-        out[k] = J
-    bound = np.linalg.inv(out)
-    return PCRBResult(information=out, bound=0.5 * (bound + np.swapaxes(bound, -1, -2)))
+    J0 = np.diag([0.0, 1.0 / s_rate**2, 1.0 / s_acc**2])
+    return air_range_pcrb(
+        truth.range, truth.dt, "nca", steps, sigma_l=sigma_l, focal=focal, size=size,
+        J0=J0, predict_first=False,
+    )  # fmt: skip
 
 
 def steady_state_variance(F: ArrayLike, Q: ArrayLike, R: ArrayLike) -> FloatArray:
