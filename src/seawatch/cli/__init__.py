@@ -264,20 +264,14 @@ def bench(
         if name not in BENCHMARKS:
             raise BadInput(f"NAME: unknown benchmark {name!r}; available: {', '.join(BENCHMARKS)}")
         import importlib
+        import inspect
 
         module = importlib.import_module(f"seawatch.bench.{name}")
+        params = inspect.signature(module.run).parameters
         kwargs: dict[str, object] = {}
-        if size is not None:
-            kwargs[
-                {
-                    "filters": "steps",
-                    "tbd": "frames",
-                    "mtt": "scans",
-                    "video": "frames",
-                    "world": "frames",
-                }[name]
-            ] = size
-        if name in ("filters", "mtt", "video", "world"):
+        if size is not None:  # a benchmark's first argument is its problem length
+            kwargs[next(iter(params))] = size
+        if "repeats" in params:
             kwargs["repeats"] = repeats
         with progress_bar() as bar:
             task = bar.add_task(f"bench {name}", total=None)
