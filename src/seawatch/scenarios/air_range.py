@@ -48,32 +48,31 @@ the few first frames).
 
 The bound (``crlb``)
 --------------------
-:func:`pcrb`: the posterior Cramér–Rao bound of the range (ALGORITHMS.md §7,
-Tichavský recursion in the singular-Q form; :func:`seawatch.metrics.crlb.
-air_range_pcrb` with one process-noise level per frame) with the state ``[d, ḋ, d̈]`` and the NCA (DWPA)
-dynamics of §5.2, whose process noise is the **truth's own motion**: the
-acceleration increment of frame k → k+1 has standard deviation ``Δa_k = |d̈(t_{k+1}) −
-d̈(t_k)|`` (0.002–0.024 m/s² per frame in the level flight, 3.7 m/s² at the onset of
-the pull-up, up to 0.34 m/s² on the arc). Prior at the first frame: nothing about the
-range (the first image size initialises it, as in the filters), rate N(0, ḋ(0)²) =
-N(0, (195.6 m/s)²) and acceleration N(0, d̈(0)²) = N(0, (0.35 m/s²)²): zero-mean like
-the filters' start, with the truth's values as one standard deviation. The
-measurement information is ``(f L / d²)² / σ_l² = 1/σ_d(d_k)²`` along the true range
-(exact, ALGORITHMS.md §5.1). Why this one: the truth is one deterministic path, so a
-Bayesian bound needs a prior process that the path is a typical draw of; treating its
-every random element (initial rate, initial acceleration, each acceleration increment)
-as a one-σ draw of a zero-mean NCA process gives the least prior information that
-still covers the truth. The bound of a *filter's* model (``air_range_pcrb`` with ncv-1's
-σ_v, say) would only describe that filter; an information-only bound on the
-deterministic path (Q = 0) is not a bound here, since no polynomial model contains
-the path. Checks (``tests/scenarios/test_air_range.py``): it equals the covariance of
-a Kalman filter with the same Q_k, R_k and prior (FilterPy, 1e-7), and the *exact*
-mean square error of every fixed-noise filter on this truth (its bias from the
-unmodelled motion plus its noise covariance, R at the true range) is never below it
-(ncv-1 touches it to 1e-4 at 3.1 s; far-segment ratios 1.02–1.06). A DWNA (NCV)
-process with σ_k = |d̈_k| gives nearly the same numbers (RMS 10.15 / 12.23 / 2.69 m,
-all / far / near, against 9.96 / 11.99 / 2.77 m) but treats the persistent
-acceleration as white noise.
+:func:`pcrb`: the posterior Cramér–Rao bound of the range (ALGORITHMS.md §7, Tichavský
+recursion in the singular-Q form; :func:`seawatch.metrics.crlb.air_range_pcrb` with one
+process-noise level per frame) with the state ``[d, ḋ, d̈]`` and the NCA (DWPA) dynamics
+of §5.2, whose process noise is the **truth's own motion**: the acceleration increment
+of frame k → k+1 has standard deviation ``Δa_k = |d̈(t_{k+1}) − d̈(t_k)|`` (0.002–0.024
+m/s² per frame in the level flight, 3.7 m/s² at the onset of the pull-up, up to 0.34
+m/s² on the arc). Prior at the first frame: nothing about the range (the first image
+size initialises it, as in the filters), rate N(0, ḋ(0)²) = N(0, (195.6 m/s)²) and
+acceleration N(0, d̈(0)²) = N(0, (0.35 m/s²)²): zero-mean like the filters' start, with
+the truth's values as one standard deviation. The measurement information is ``(f L /
+d²)² / σ_l² = 1/σ_d(d_k)²`` along the true range (exact, ALGORITHMS.md §5.1). Why this
+one: the truth is one deterministic path, so a Bayesian bound needs a prior process that
+the path is a typical draw of; treating its every random element (initial rate, initial
+acceleration, each acceleration increment) as a one-σ draw of a zero-mean NCA process
+gives the least prior information that still covers the truth. The bound of a *filter's*
+model (``air_range_pcrb`` with ncv-1's σ_v, say) would only describe that filter; an
+information-only bound on the deterministic path (Q = 0) is not a bound here, since no
+polynomial model contains the path. Checks (``tests/scenarios/test_air_range.py``): it
+equals the covariance of a Kalman filter with the same Q_k, R_k and prior (FilterPy,
+1e-7), and the *exact* mean square error of every fixed-noise filter on this truth (its
+bias from the unmodelled motion plus its noise covariance, R at the true range) is never
+below it (ncv-1 touches it to 1e-4 at 3.1 s; far-segment ratios 1.02–1.06). A DWNA (NCV)
+process with σ_k = |d̈_k| gives nearly the same numbers (RMS 10.15 / 12.23 / 2.69 m, all
+/ far / near, against 9.96 / 11.99 / 2.77 m) but treats the persistent acceleration as
+white noise.
 
 Figures (:func:`run_demo`, ``merge`` with ``out_dir``): ``range_error.png`` (every
 filter, σ_v of the adaptive ones) and the paper's Figs. 3–6 (:data:`FIGURES`):
