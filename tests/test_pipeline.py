@@ -28,12 +28,6 @@ def _rows(path):
         return list(csv.DictReader(fh))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="74 % of the rows within 3 sigma (bound 90 %), errors growing to 4.9 sigma: since "
-    "the horizon is found to 0.05 px the detected water line's low bias (0.5-1.3 px) is "
-    "no longer offset by the old horizon's low bias; the detector fix is pending (issue 6)",
-)
 def test_positions_agree_with_the_rendered_truth_within_their_sigma(clip, tmp_path):
     # the case's mast sways: the horizon gives each frame's pitch and roll
     cam = load_camera(clip / "camera.yaml")

@@ -107,12 +107,6 @@ def _late_errors(clip: Path, rows: list[dict]) -> tuple[list[dict], list[float],
     return late, err, float(truth[int(late[0]["frame"])]["range_m"])
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="EKF position RMS 72.5 m = 7.3 % of the 999 m range (bound 5 %): since the "
-    "horizon is found to 0.05 px the detected water line's low bias (0.5-1.3 px) is no "
-    "longer offset by the old horizon's low bias; the detector fix is pending (issue 6)",
-)
 def test_positions_are_within_5_percent_of_the_range(clip, horizon_run):
     _, out = horizon_run
     _, err, rng = _late_errors(clip, _rows(out / "tracks.csv"))

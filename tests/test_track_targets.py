@@ -42,16 +42,9 @@ SMALL = {"width": 960, "height_px": 540, "fps": 5.0}
 # measured at 960×540, 5 frames/s (seed 0) — the reasons of the strict xfails below
 XFAIL: dict[tuple[str, str], str] = {
     ("range-1km", "range1km"): (
-        "issue 7 '5 % at 1 km' not met at 960x540: EKF range error 8.30 % RMS (bias "
-        "-7.04 %) in the 750-1250 m bin (1080p/10 fps: 4.1 %, met, docs/results/track/); "
-        "at half the resolution one water-line pixel is twice the angle, and the detected "
-        "water line sits below the true one"
-    ),
-    ("uav-sea", "rmse30"): (
-        "issue 7 '30 % below geometry' not met: EKF 84.4 m vs geometry 104.2 m (ratio "
-        "0.81) at 960x540 (1080p: 56.5 vs 64.8 m, 0.87). Since the horizon is found to "
-        "0.03 px, point-wise geometry lost its horizon bias and both are limited by the "
-        "detected water line (0.5-1.3 px low, a bias no filter removes)"
+        "issue 7 '5 % at 1 km' not met at 960x540: EKF range error 5.46 % RMS (bias "
+        "-3.91 %) in the 750-1250 m bin (met at 1080p/10 fps, docs/results/track/); at "
+        "half the resolution one water-line pixel is twice the angle"
     ),
 }
 

@@ -3,9 +3,13 @@
 Truths: synthetic sea scenes drawn here with known ship boxes and water lines (textured
 sea with perspective waves and noise, small and large, dark and bright ships with hull
 and superstructure, a sun-glitter patch and a coastline band that must give no boxes,
-camera roll); 88 real thermal frames with a hand-made boat box per frame (MarDCT video
-ir-3 annotated by the TIRSD repository, Apache-2.0; ``../shared/data/mardct_ir3/``, read
-in place); hand-built YOLO output tensors whose boxes are known.
+camera roll); hulls painted with their exact area coverage at fractional water lines
+(and sloping, one in front of another, with a sub-pixel mast), blurred like a lens;
+rendered H.264 footage (``seawatch.synth.render``) against its ``truth.csv``; 88 real
+thermal frames with a hand-made boat box per frame (MarDCT video ir-3 annotated by the
+TIRSD repository, Apache-2.0; ``../shared/data/mardct_ir3/``, read in place); hand-built
+YOLO output tensors whose boxes are known. Both object refinements of the classical
+detector (``refine="mask"``, the default, and ``"flank"``) are checked.
 """
 
 from __future__ import annotations
@@ -35,6 +39,7 @@ needs_mardct = pytest.mark.skipif(
     not (MARDCT / "boxes.csv").is_file(),
     reason=f"MarDCT ir-3 frames not found at {MARDCT} (shared data folder absent)",
 )
+REFINE = ("mask", "flank")  # ClassicalShipDetector's object refinements
 
 
 # ------------------------------------------------------------------ synthetic scenes
@@ -229,33 +234,46 @@ def test_sea_region_is_the_area_below_the_line():
 # ------------------------------------------------------------------ classical detector
 
 
-def test_finds_small_large_dark_and_bright_ships_with_their_water_lines():
+@pytest.mark.parametrize("refine", REFINE)
+def test_finds_small_large_dark_and_bright_ships_with_their_water_lines(refine):
     rng = np.random.default_rng(1234)
     img, truth, hz = sea_scene(rng, ships=fixed_ships(), coast=True)
-    det = ClassicalShipDetector()(as_u8(img), horizon=hz)
+    det = ClassicalShipDetector(refine=refine)(as_u8(img), horizon=hz)
     found, n_false = match(det, truth)
     assert (found >= 0).all(), f"missed {truth[found < 0]}"
     assert n_false == 0
     assert ((det.score > 0) & (det.score <= 1)).all()
-    for i, j in enumerate(found[:4]):
-        # water line: the hull's bottom edge, near the hull's centre column; the box
-        # holds the superstructure
-        assert abs(det.v_wl[j] - truth[i, 5]) <= 1.5
+    whole = range(5) if refine == "flank" else range(3)
+    for i in whole:
+        # the whole ship is boxed (hull and superstructure); the water line is the
+        # hull's bottom edge (at a pixel border here) near the hull's centre column
+        j = found[i]
+        np.testing.assert_allclose(det.boxes[j, :4], truth[i, :4], atol=1.0)
+        assert abs(det.v_wl[j] - truth[i, 5]) <= 0.3
         assert abs(det.u_wl[j] - truth[i, 4]) <= max(2.0, truth[i, 2] / 8)
-        assert det.y[j] <= truth[i, 1] + 2
-    # Known limit: the 60 px bright hull (+30 grey levels over 4-level waves) is wider
-    # than the finest scale's guard window, and at the coarser scale its own CFAR shadow
-    # raises the noise estimate; only its superstructure (20 × 9 px) is boxed.
-    j = found[4]
-    assert truth[4, 0] <= det.x[j] and det.x[j] + det.w[j] <= truth[4, 0] + truth[4, 2]
+    if refine == "mask":
+        # refine="mask": the 90 px dark hull's tapered ends (under half the contrast of
+        # its 0.4 × p95 threshold after the CFAR's own shadow) are left out of its box,
+        # its water line and top are found
+        j = found[3]
+        assert abs(det.v_wl[j] - truth[3, 5]) <= 0.3 and det.y[j] <= truth[3, 1] + 2
+        # Known limit of refine="mask": the 60 px bright hull (+30 grey levels over
+        # 4-level waves) is wider than the finest scale's CFAR guard window, and at the
+        # coarser scale its own CFAR shadow raises the noise estimate; only its
+        # superstructure (20 × 9 px) is boxed. refine="flank" boxes it whole.
+        j = found[4]
+        assert truth[4, 0] <= det.x[j] and det.x[j] + det.w[j] <= truth[4, 0] + truth[4, 2]
 
 
-def test_random_scenes_recall_and_false_boxes_per_frame():
+@pytest.mark.parametrize("refine", REFINE)
+def test_random_scenes_recall_and_false_boxes_per_frame(refine):
     """Seeded random scenes (5 ships, glitter patch, coastline, roll up to ±3°): recall
-    ≥ 0.75 and at most 0.5 false boxes per frame (measured 0.83 and 0.20 on 20 scenes;
-    the misses are ships inside the glitter and large ones hugging the horizon)."""
+    ≥ 0.75 and at most 0.5 false boxes per frame (committed detector: 0.80 and 0.08 on
+    these 12 scenes; measured 0.78 and 0.17 with refine="mask", 0.78 and 0.17 with
+    "flank"; the misses are ships inside the glitter and large ones hugging the
+    horizon)."""
     rng = np.random.default_rng(1234)
-    det = ClassicalShipDetector()
+    det = ClassicalShipDetector(refine=refine)
     hits = total = false = 0
     n = 12
     for _ in range(n):
@@ -273,10 +291,11 @@ def test_random_scenes_recall_and_false_boxes_per_frame():
     assert false / n <= 0.5
 
 
-def test_glitter_patch_and_coastline_give_no_boxes():
+@pytest.mark.parametrize("refine", REFINE)
+def test_glitter_patch_and_coastline_give_no_boxes(refine):
     rng = np.random.default_rng(7)
     img, _, hz = sea_scene(rng, glint=(320, 220, 70, 18), coast=True)
-    det = ClassicalShipDetector()(as_u8(img), horizon=hz)
+    det = ClassicalShipDetector(refine=refine)(as_u8(img), horizon=hz)
     assert len(det) == 0, det.boxes
 
 
@@ -440,23 +459,211 @@ def test_bad_mask_horizon_and_options_raise_value_error_naming_them():
         ({"max_size": 2}, "max_size"),
         ({"max_aspect": (0.5, 2)}, "max_aspect"),
         ({"temporal_rate": 0}, "temporal_rate"),
+        ({"refine": "grabcut"}, "refine"),
     ]:
         with pytest.raises(ValueError, match=name):
             ClassicalShipDetector(**kw)
+
+
+# ------------------------------------------------------------------ water line, whole ships
+
+
+def paint_polygon(img: np.ndarray, poly, value: float, ss: int = 16) -> None:
+    """Paint a convex polygon (K, 2) [px] onto a float image in place, each pixel mixed
+    by the fraction of it the polygon covers (ss × ss samples per pixel; pixel (r, c)
+    covers [c − ½, c + ½] × [r − ½, r + ½]): an ideal anti-aliased drawing."""
+    poly = np.asarray(poly, float)
+    h, w = img.shape
+    c0 = max(0, int(np.floor(poly[:, 0].min() + 0.5)))
+    c1 = min(w - 1, int(np.ceil(poly[:, 0].max() - 0.5)))
+    r0 = max(0, int(np.floor(poly[:, 1].min() + 0.5)))
+    r1 = min(h - 1, int(np.ceil(poly[:, 1].max() - 0.5)))
+    off = (np.arange(ss) + 0.5) / ss - 0.5
+    X = (np.arange(c0, c1 + 1)[:, None] + off).ravel()[None, :]
+    Y = (np.arange(r0, r1 + 1)[:, None] + off).ravel()[:, None]
+    inside = np.ones((Y.size, X.size), bool)
+    k = len(poly)
+    area2 = sum(
+        poly[i, 0] * poly[(i + 1) % k, 1] - poly[(i + 1) % k, 0] * poly[i, 1] for i in range(k)
+    )
+    for i in range(k):
+        (ax, ay), (bx, by) = poly[i], poly[(i + 1) % k]
+        inside &= np.sign(area2) * ((bx - ax) * (Y - ay) - (by - ay) * (X - ax)) >= 0
+    a = inside.reshape(r1 - r0 + 1, ss, c1 - c0 + 1, ss).mean(axis=(1, 3))
+    img[r0 : r1 + 1, c0 : c1 + 1] += a * (value - img[r0 : r1 + 1, c0 : c1 + 1])
+
+
+def box_ship(img, base, cx, wl, length, hull, contrast, sup=(0.4, 6), slope=0.0):
+    """A hull (length × hull px) whose bottom edge passes through (cx, wl) with the given
+    slope [px/px], a superstructure (sup[0] × length wide, sup[1] px high) on it, drawn
+    with exact coverage at ``contrast`` grey levels from the local sea. Returns the truth
+    row (x, y, w, h, u_wl, v_wl)."""
+    bg = float(np.median(base[int(wl) - 12 : int(wl) + 12, int(cx - length) : int(cx + length)]))
+    a, b = cx - length / 2, cx + length / 2
+    ya, yb = wl - slope * length / 2, wl + slope * length / 2
+    paint_polygon(img, [(a, ya - hull), (b, yb - hull), (b, yb), (a, ya)], bg + contrast)
+    top = min(ya, yb) - hull
+    if sup[1]:
+        s = sup[0] * length / 2
+        paint_polygon(img, [(cx - s, top - sup[1]), (cx + s, top - sup[1]), (cx + s, top + 0.5),
+                            (cx - s, top + 0.5)], bg + 0.8 * contrast)  # fmt: skip
+        top -= sup[1]
+    return (a, top, length, max(ya, yb) - top, cx, wl)
+
+
+def hull_scene(seed: int, blur: float):
+    """Six ships (hulls 5–10 px high, 36–60 px long, ±40–45 grey levels) whose water
+    lines fall at eighths of a pixel, blurred like a lens (Gaussian, ``blur`` px), with
+    noise 2 grey levels; returns the 8-bit frame, truth and horizon."""
+    rng = np.random.default_rng(seed)
+    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
+    img = base.copy()
+    specs = [
+        (130, 175.0, 40, 6, -40),
+        (300, 190.125, 50, 8, 40),
+        (470, 205.25, 36, 5, -45),
+        (140, 260.375, 56, 9, 45),
+        (320, 285.5, 44, 7, -40),
+        (500, 300.625, 60, 10, 40),
+    ]  # (cx, water line, length, hull height, contrast)
+    truth = np.array([box_ship(img, base, *sp) for sp in specs])
+    if blur:
+        img = cv2.GaussianBlur(img, (0, 0), blur)
+    return as_u8(img + rng.normal(0, 2.0, img.shape)), truth, hz
+
+
+@pytest.mark.parametrize("refine", REFINE)
+@pytest.mark.parametrize("blur", [0.0, 0.8, 1.2])
+def test_water_line_of_antialiased_blurred_hulls_is_found_to_a_tenth_of_a_pixel(blur, refine):
+    """Sub-pixel water line: the bottom of a thresholded mask is off by up to a pixel
+    (0.3 px RMS from the pixel grid alone, more with blur); the coverage integral across
+    the hull/sea edge is not moved by a symmetric blur. Measured RMS 0.05–0.09 px, worst
+    0.2 px (a 5 px hull under 1.2 px blur); the committed detector: 0.25–1.5 px on the
+    same five hulls (it also boxes the sixth without its hull, as refine="mask" does)."""
+    img, truth, hz = hull_scene(1234, blur)
+    det = ClassicalShipDetector(refine=refine)(img, horizon=hz)
+    found, n_false = match(det, truth)
+    assert (found >= 0).all() and n_false == 0
+    hulls = np.arange(6)
+    if refine == "mask":  # the 56 px bright hull: its superstructure boxed alone (above)
+        hulls = np.array([0, 1, 2, 4, 5])
+        j = found[3]
+        assert truth[3, 0] <= det.x[j] and det.x[j] + det.w[j] <= truth[3, 0] + truth[3, 2]
+    dv = det.v_wl[found[hulls]] - truth[hulls, 5]
+    assert np.abs(dv).max() <= 0.3
+    assert np.sqrt(np.mean(dv**2)) <= 0.12
+    assert abs(dv.mean()) <= 0.08
+    assert np.abs(det.u_wl[found[hulls]] - truth[hulls, 4]).max() <= 1.0  # the hull's middle
+
+
+@pytest.mark.parametrize("refine", REFINE)
+def test_water_line_of_a_hull_seen_at_an_angle_lies_on_its_sloping_edge(refine):
+    rng = np.random.default_rng(1234)
+    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
+    img = base.copy()
+    slope = 4.0 / 70  # the hull's bottom falls 4 px over its 70 px
+    t = box_ship(img, base, 320.0, 230.3, 70, 9, -40, sup=(0.3, 7), slope=slope)
+    img = as_u8(cv2.GaussianBlur(img, (0, 0), 0.8) + rng.normal(0, 2.0, img.shape))
+    det = ClassicalShipDetector(refine=refine)(img, horizon=hz)
+    found, n_false = match(det, np.array([t]))
+    assert found[0] >= 0 and n_false == 0
+    u, v = det.u_wl[found[0]], det.v_wl[found[0]]
+    assert abs(u - t[4]) <= 1.0
+    assert abs(v - (t[5] + slope * (u - t[4]))) <= 0.15  # on the edge, not its lowest end
+
+
+@pytest.mark.parametrize("refine", REFINE)
+def test_ship_in_front_of_another_gives_two_boxes_with_their_own_water_lines(refine):
+    """A 40 px ship 2.3 px lower in the image (nearer) in front of a 90 px one: one
+    connected object whose water line jumps; the committed detector gave one box (the
+    far ship's) with a water line between the two."""
+    rng = np.random.default_rng(1234)
+    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
+    img = base.copy()
+    far = box_ship(img, base, 300.0, 200.4, 90, 7, -45, sup=(1 / 3, 6))
+    near = box_ship(img, base, 310.0, 202.7, 40, 8, -70, sup=(0, 0))
+    img = as_u8(cv2.GaussianBlur(img, (0, 0), 0.7) + rng.normal(0, 2.0, img.shape))
+    det = ClassicalShipDetector(refine=refine)(img, horizon=hz)
+    truth = np.array([far, near])
+    found, n_false = match(det, truth)
+    assert (found >= 0).all() and n_false == 0
+    np.testing.assert_allclose(det.v_wl[found], truth[:, 5], atol=0.2)
+    # the far ship spans the near one; each box's sides are its own
+    np.testing.assert_allclose(det.x[found], truth[:, 0], atol=1.0)
+    np.testing.assert_allclose(det.x[found] + det.w[found], truth[:, 0] + truth[:, 2], atol=1.0)
+
+
+@pytest.mark.parametrize("refine", REFINE)
+def test_thin_mast_is_inside_the_box(refine):
+    rng = np.random.default_rng(1234)
+    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
+    img = base.copy()
+    t = box_ship(img, base, 320.0, 240.5, 40, 6, -40, sup=(0, 0))
+    paint_polygon(img, [(319.65, 218.2), (320.35, 218.2), (320.35, 234.5), (319.65, 234.5)],
+                  float(np.median(base[230:250, 280:360])) - 60)  # fmt: skip
+    img = as_u8(cv2.GaussianBlur(img, (0, 0), 0.7) + rng.normal(0, 2.0, img.shape))
+    det = ClassicalShipDetector(refine=refine)(img, horizon=hz)
+    found, n_false = match(det, np.array([t]))
+    assert found[0] >= 0 and n_false == 0
+    assert abs(det.y[found[0]] - 218.2) <= 1.0  # a 0.7 px mast 16 px high: the box's top
+
+
+@pytest.mark.parametrize("refine", REFINE)
+def test_rendered_footage_water_line_matches_truth_within_the_renderers_fill(tmp_path, refine):
+    """Rendered H.264 footage (``seawatch.synth.render``): a 50 m ferry 800 m out and a
+    30 m workboat 1 km out, broadside to a camera 10 m up (960×540, 60°), 10 frames.
+    Detected minus truth water line, per ship: mean in [−0.1, +0.4] px, spread ≤ 0.15 px.
+    The upper margin is the renderer's, not the detector's: its anti-aliased fill paints a
+    hull's bottom edge 0.21–0.52 px (mean 0.29) below the polygon (OpenCV LINE_AA on a
+    polygon pulled in by half a pixel), and the visible water line is the hull's near
+    side, 0.05 px below midship here; measured +0.26 (ferry) and +0.29 (workboat). The
+    committed detector: +1.2 and +1.1 px."""
+    from seawatch.camera import PinholeCamera
+    from seawatch.io.video import VideoReader
+    from seawatch.synth import render
+    from seawatch.synth.world import Trajectory, make_ship
+
+    cam = PinholeCamera.from_fov(960, 540, 60.0, height=10.0, heading=0.0, pitch=-0.0175)
+    t = np.array([0.0, 10.0])
+    ships = [
+        make_ship(1, Trajectory(t, np.full(2, 800.0), -60 + 3 * t, np.full(2, np.pi / 2)), 50.0,
+                  kind="ferry"),
+        make_ship(2, Trajectory(t, np.full(2, 1000.0), 120 + 3 * t, np.full(2, np.pi / 2)), 30.0,
+                  kind="workboat"),
+    ]  # fmt: skip
+    res = render(cam, ships, 1.0, 10.0, out_dir=tmp_path, seed=3)
+    truth = list(csv.DictReader(res.truth.open()))
+    lines = {int(r["frame"]): [float(r[k]) for k in ("x0", "y0", "x1", "y1")]
+             for r in csv.DictReader(res.horizon.open())}  # fmt: skip
+    det = ClassicalShipDetector(refine=refine)
+    errors: dict[int, list[float]] = {1: [], 2: []}
+    with VideoReader(res.video) as reader:
+        for fr in reader:
+            boxes = det(fr.image, horizon=lines[fr.index])
+            for r in (r for r in truth if int(r["frame"]) == fr.index):
+                x, y, w, h = (float(r[k]) for k in "xywh")
+                d = np.abs(boxes.centers - [x + w / 2, y + h / 2]).sum(axis=1)
+                assert d.min() <= 3.0  # found, its box centre within 3 px
+                errors[int(r["object_id"])].append(boxes.v_wl[np.argmin(d)] - float(r["v_wl"]))
+    for e in errors.values():
+        assert len(e) == 10
+        assert -0.1 <= np.mean(e) <= 0.4
+        assert np.std(e) <= 0.15
 
 
 # ------------------------------------------------------------------ real thermal frames
 
 
 @needs_mardct
-def test_mardct_thermal_boat_recall_at_least_0_9_with_at_most_half_a_false_box_per_frame():
+@pytest.mark.parametrize("refine", REFINE)
+def test_mardct_thermal_boat_recall_at_least_0_9_with_at_most_half_a_false_box_per_frame(refine):
     """Issue 6 target on real pixels: a detection centre within 12 px (city block) of the
     annotated box centre in ≥ 90 % of the 88 frames, ≤ 0.5 false boxes per frame. The
     sea region comes from the horizon detector (the sea–land boundary here)."""
     from seawatch.vision.horizon import detect_horizon
 
     rows = sorted(csv.DictReader((MARDCT / "boxes.csv").open()), key=lambda r: int(r["frame"]))
-    det = ClassicalShipDetector()
+    det = ClassicalShipDetector(refine=refine)
     hits = false = 0
     for r in rows:
         img = cv2.imread(str(MARDCT / "images" / r["file"]), cv2.IMREAD_UNCHANGED)

@@ -18,8 +18,10 @@ and one result, :class:`Detections`:
 Pixels: ``x``/``u`` right, ``y``/``v`` down, origin at the centre of the top-left pixel
 (INTERFACES.md), so the pixel in row r and column c covers ``[c - 0.5, c + 0.5] ×
 [r - 0.5, r + 0.5]``. A box is its top-left corner ``(x, y)`` and size ``(w, h)`` [px];
-the water-line point ``(u_wl, v_wl)`` [px] is where the hull meets the water: the bottom
-edge of the lowest object pixel near the box's centre column.
+the water-line point ``(u_wl, v_wl)`` [px] is where the hull meets the water, at the
+middle of the hull: the hull/sea edge located to a fraction of a pixel (per column, the
+coverage integral of the intensity step between hull and sea; a robust line through the
+hull's columns).
 
 Colour frames are taken in OpenCV's BGR(A) order; grey frames may be 8-bit, 16-bit
 (thermal) or float. Intensities stay in the frame's own units (grey levels or counts).
@@ -32,6 +34,7 @@ import inspect
 import itertools
 import math
 import os
+import warnings
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -708,15 +711,31 @@ class _Frame:
     hrow: float  # the horizon's (or sea top's) row in the band [working px]; 0 if unknown
     colour: NDArray | None = None  # the full-resolution BGR frame
     chroma: list[tuple[int, NDArray]] | None = None  # (YCrCb channel, half-resolution band)
+    quantum: float = 0.0  # the grey levels' quantum [units] (0: continuous)
+    _rows: NDArray | None = None  # grey rows converted from ``colour`` (grey_rows)
+    _done: NDArray | None = None
 
     def grey_crop(self, y0: int, y1: int, x0: int, x1: int) -> NDArray:
         """Rows ``y0 … y1 − 1``, columns ``x0 … x1 − 1`` of the full-resolution grey frame
         (float32; converted from the colour frame on demand)."""
+        return self.grey_rows(y0, y1)[:, x0:x1].astype(np.float32)
+
+    def grey_rows(self, y0: int, y1: int) -> NDArray:
+        """Rows ``y0 … y1 − 1`` (within the frame) of the full-resolution grey frame, all
+        columns (converted from a colour frame once per row and kept)."""
         if self.grey is not None:
-            return self.grey[y0:y1, x0:x1].astype(np.float32)
+            return self.grey[y0:y1]
         assert self.colour is not None
-        crop = np.ascontiguousarray(self.colour[y0:y1, x0:x1])
-        return cv2.cvtColor(crop, cv2.COLOR_BGR2GRAY).astype(np.float32)
+        H, W = self.shape
+        if self._rows is None:
+            self._rows = np.empty((H, W), self.colour.dtype)
+            self._done = np.zeros(H, dtype=bool)
+        todo = np.flatnonzero(~self._done[y0:y1])
+        if todo.size:
+            a, b = y0 + int(todo[0]), y0 + int(todo[-1]) + 1
+            cv2.cvtColor(self.colour[a:b], cv2.COLOR_BGR2GRAY, dst=self._rows[a:b])
+            self._done[a:b] = True
+        return self._rows[y0:y1]
 
     def box_to_work(self, box: NDArray) -> tuple[float, float, float, float]:
         """Inclusive band-pixel box → unsheared working-pixel box (x0, y0, x1, y1)."""
@@ -801,10 +820,28 @@ class ClassicalShipDetector:
        wider one replaces the finer ones inside it. Fragments of one ship (hull and
        superstructure) are merged when they overlap on one axis with a gap of at most
        ``merge_gap`` × the smaller height on the other.
-    5. Inside each candidate, at full resolution: the pixels whose noise-normalised
-       contrast exceeds 0.4 × its 95th percentile in the candidate (the components that
-       touch the candidate) give the box and the water-line point: the bottom edge of the
-       lowest object pixel within the central half of the box's columns.
+    5. Inside each candidate, at full resolution, an object mask — ``refine="mask"``
+       (default, :meth:`_refine_mask`): the pixels whose noise-normalised contrast
+       against the level's CFAR backgrounds exceeds 0.4 × its 95th percentile in the
+       candidate (the components that touch it); ``refine="flank"``
+       (:meth:`_refine`, :meth:`_segment`): the object against a background of its own
+       (per line parallel to the horizon, from flanks 1.5–3.5 object widths away), by
+       polarity, with hysteresis, the window grown until the whole ship is in it —
+       whole ships where the CFAR's own shadow hides a long hull, parts of less contrast
+       (superstructure, masts) joined, background structure reaching the window's edge
+       (a glint path) dropped; it costs a few ms per candidate more. Then
+       (:meth:`_ships`): the box is the extent of the object's pixels that are at least
+       half covered; the water-line point is the hull/sea edge at the middle of the
+       hull's columns, to a fraction of a pixel (:func:`_edge_waterline`: per column the
+       coverage integral of the unsmoothed intensity step between the hull's and the
+       sea's levels — or colours —, which neither the smoothing, the threshold nor a
+       symmetric lens or codec blur moves; a Theil–Sen line through the columns), or,
+       when that edge is too faint, the bottom edge of the lowest object pixel within
+       the central half of the box's columns. Where the water line jumps between flat
+       levels (:func:`_waterline_levels`), the object is two ships, one in front of the
+       other or side by side, each boxed with its own water line; detections that are a
+       part of another (a superstructure boxed alone, two candidates of one ship) are
+       dropped (:func:`_distinct`).
     6. A box is kept if its water-line point lies on the sea (``sea_mask``, or on or
        below the horizon line with ``horizon_tolerance · H`` of slack; the box itself may
        rise above the horizon), its sides are ≥ ``min_size`` and ≤ ``max_size`` × the
@@ -853,6 +890,7 @@ class ClassicalShipDetector:
         clutter_rate: float = 0.01,
         colour: bool = True,
         max_candidates: int = 200,
+        refine: Literal["mask", "flank"] = "mask",
     ) -> None:
         self.threshold = positive("threshold", threshold)
         self.grow_threshold = positive("grow_threshold", grow_threshold)
@@ -896,6 +934,9 @@ class ClassicalShipDetector:
         self.clutter_rate = positive("clutter_rate", clutter_rate, allow_zero=True)
         self.max_candidates = _int("max_candidates", max_candidates, 1)
         self.colour = bool(colour)
+        if refine not in ("mask", "flank"):
+            raise ValueError(f"refine: expected 'mask' or 'flank', got {refine!r}")
+        self.refine: Literal["mask", "flank"] = refine
         self._buffers: dict[tuple[Any, ...], NDArray] = {}
 
     def reset(self) -> None:
@@ -946,28 +987,30 @@ class ClassicalShipDetector:
         cands = [c for c in cands if self._near_sea(c, fr, mask, ends, tol)]
         cands = self._clutter_test(cands, levels[0])
         cands = self._merge(self._resolve_scales(cands))
+        # merged, a ship's candidate reaches down to its hull: one whose bottom is above
+        # the sea by more than its height is a cloud or a coast feature
+        cands = [c for c in cands if self._near_sea(c, fr, mask, ends, tol, 1.0)]
         out = []
         for c in cands:
-            r = self._refine(c, levels[c.level], fr)
-            if r is None:
-                continue
-            x, y, w, h, u, v, area = r
-            if (
-                min(w, h) < self.min_size
-                or w > self.max_size * W
-                or h > self.max_size * H
-                or w > self.max_aspect[0] * h
-                or h > self.max_aspect[1] * w
-                or area < self.min_area
-                or not _in_sea(u, v, mask, ends, (H, W), tol)
-            ):
-                continue
-            score = 1.0 - math.exp(-0.5 * (c.peak / self.threshold) ** 2)
-            out.append((x, y, w, h, score, u, v))
+            refine = self._refine if self.refine == "flank" else self._refine_mask
+            for x, y, w, h, u, v, area in refine(c, levels[c.level], fr):
+                if (
+                    min(w, h) < self.min_size
+                    or w > self.max_size * W
+                    or h > self.max_size * H
+                    or w > self.max_aspect[0] * h
+                    or h > self.max_aspect[1] * w
+                    or area < self.min_area
+                    or not _in_sea(u, v, mask, ends, (H, W), tol)
+                ):
+                    continue
+                score = 1.0 - math.exp(-0.5 * (c.peak / self.threshold) ** 2)
+                out.append((x, y, w, h, score, u, v))
         if not out:
             return Detections.empty()
         arr = np.array(out, dtype=np.float64)
-        return Detections(arr[np.argsort(-arr[:, 4], kind="stable")])
+        arr = arr[np.argsort(-arr[:, 4], kind="stable")]
+        return Detections(arr[_distinct(arr)])
 
     def _frame(
         self,
@@ -1028,7 +1071,7 @@ class ClassicalShipDetector:
                     continue  # a flat chroma plane (a grey frame stored as colour)
                 chroma.append((ch_index, half))
         hrow = top - wtop if ends is not None or mask is not None else 0.0
-        return _Frame((H, W), grey, band, wtop, sx, sy, off, hrow, colour, chroma)
+        return _Frame((H, W), grey, band, wtop, sx, sy, off, hrow, colour, chroma, quantum)
 
     def _shear(
         self, src: NDArray, shift: NDArray, rows: int, name: str, half: bool = False
@@ -1271,17 +1314,18 @@ class ClassicalShipDetector:
         mask: NDArray[np.bool_] | None,
         ends: tuple[float, float] | None,
         tol: float,
+        heights: float = 2.0,
     ) -> bool:
         """Pre-filter before merging: a candidate whose bottom lies above the sea by more
-        than ``tol`` plus twice its own height can be neither a ship nor a ship's upper
-        part (full-frame pixels)."""
+        than ``tol`` plus ``heights`` times its own height (2: a ship's upper part) can
+        be no ship (full-frame pixels)."""
         if mask is None and ends is None:
             return True
         x0, y0, x1, y1 = fr.box_to_work(c.box)
         h = (y1 - y0 + 1) * fr.sy
         u = 0.5 * (x0 + x1 + 1) * fr.sx - 0.5
         v = (y1 + 1) * fr.sy - 0.5
-        return _in_sea(u, v, mask, ends, fr.shape, tol + 2 * h)
+        return _in_sea(u, v, mask, ends, fr.shape, tol + heights * h)
 
     def _resolve_scales(self, cands: list[_Candidate]) -> list[_Candidate]:
         """Coarse-to-fine arbitration: a coarse candidate narrow enough for the next finer
@@ -1307,6 +1351,13 @@ class ClassicalShipDetector:
                         ci.peak = max(ci.peak, cands[j].peak)
         return [c for c, a in zip(cands, alive, strict=True) if a]
 
+    def _mergeable(self, a: NDArray, b: NDArray) -> bool:
+        """:meth:`_merge`'s rule for two inclusive boxes ``(x0, y0, x1, y1)``."""
+        gap = max(1.0, self.merge_gap * (min(a[3] - a[1], b[3] - b[1]) + 1))
+        gx = max(a[0], b[0]) - min(a[2], b[2]) - 1
+        gy = max(a[1], b[1]) - min(a[3], b[3]) - 1
+        return bool((gx < 0 and gy <= gap) or (gy < 0 and gx <= gap) or max(gx, gy) < 1)
+
     def _merge(self, cands: list[_Candidate]) -> list[_Candidate]:
         """Merge the fragments of one ship (hull and superstructure, a hull cut by a wave):
         boxes that overlap on one axis with a gap of at most ``merge_gap`` × the smaller
@@ -1318,10 +1369,7 @@ class ClassicalShipDetector:
             for i in range(len(cands)):
                 for j in range(i + 1, len(cands)):
                     a, b = cands[i].box, cands[j].box
-                    gap = max(1.0, self.merge_gap * (min(a[3] - a[1], b[3] - b[1]) + 1))
-                    gx = max(a[0], b[0]) - min(a[2], b[2]) - 1
-                    gy = max(a[1], b[1]) - min(a[3], b[3]) - 1
-                    if (gx < 0 and gy <= gap) or (gy < 0 and gx <= gap) or max(gx, gy) < 1:
+                    if self._mergeable(a, b):
                         box = np.concatenate([np.minimum(a[:2], b[:2]), np.maximum(a[2:], b[2:])])
                         level = min(cands[i].level, cands[j].level)
                         cands[i] = _Candidate(box, level, max(cands[i].peak, cands[j].peak))
@@ -1334,9 +1382,158 @@ class ClassicalShipDetector:
 
     def _refine(
         self, c: _Candidate, lv: _Level, fr: _Frame
-    ) -> tuple[float, float, float, float, float, float, float] | None:
-        """Full-resolution object mask inside a candidate: box (x, y, w, h), water-line
-        point (u, v) [px] and object area [px²]; None when nothing stands out."""
+    ) -> list[tuple[float, float, float, float, float, float, float]]:
+        """Full-resolution objects of a candidate: per object its box (x, y, w, h), water-
+        line point (u, v) [px] and area [px²]; none when nothing stands out.
+
+        The objects are segmented against a background of their own (:meth:`_segment`)
+        in a window around the candidate (half its width ``w`` on either side, at least
+        8 px; a quarter of its height above and below, at least 4 px; the background's
+        flanks from 1.5 w to 3.5 w beyond it, or what lies between the window and the
+        frame's edge). An object that reaches the
+        window's edge may be longer or taller than the candidate (a superstructure that
+        stood out at a fine scale, the end of a long hull): the window is grown around
+        it and the segmentation repeated (at most three times). Parts that still reach
+        the window's edge are the background's own structure (a glint path, a wave
+        crest or a coastline running on; a greatest-of CFAR does not see them either)
+        and are dropped; the
+        remaining parts that touch (a dark hull under a bright superstructure) are one
+        object, unless it is no ship as a whole (:meth:`_ships`), when each part is tried
+        alone (a dark hull touching a bright glint patch).
+        """
+        sx, sy = fr.sx, fr.sy
+        H, W = fr.shape
+        bx0, by0, bx1, by1 = fr.box_to_work(c.box)  # unsheared working pixels
+        core = (
+            max(0, math.floor(bx0 * sx)),
+            max(0, math.floor(by0 * sy)),
+            min(W, math.ceil((bx1 + 1) * sx)),
+            min(H, math.ceil((by1 + 1) * sy)),
+        )  # full-frame pixels [x0, x1) × [y0, y1)
+        if core[2] - core[0] < 1 or core[3] - core[1] < 1:
+            return []
+        ext = core
+        for _ in range(3):
+            we, he = ext[2] - ext[0], ext[3] - ext[1]
+            rx, ry = max(8, we // 2), max(4, he // 4 + 2)
+            win = (
+                max(0, ext[0] - rx),
+                max(0, ext[1] - ry),
+                min(W, ext[2] + rx),
+                min(H, ext[3] + ry),
+            )
+            # the flanks: from 1.5 w to 3.5 w beyond the object, clear of a hull up to four
+            # times as long as its superstructure was
+            near, far = max(2 * rx, 3 * we // 2), max(4 * rx, 7 * we // 2)
+            left = (max(0, ext[0] - far), max(0, ext[0] - near))
+            right = (min(W, ext[2] + near), min(W, ext[2] + far))
+            if left[1] - left[0] < 8:  # cut by the frame's edge: what lies beside the window
+                left = (0, win[0])
+            if right[1] - right[0] < 8:
+                right = (win[2], W)
+            flanks = (left, right)
+            parts, absdiff, colour = self._segment(fr, lv, win, flanks, core)
+            if not parts:
+                return []
+            boxes = np.array([_mask_extent(p) for p in parts])  # r0, r1, c0, c1
+            r0, r1 = int(boxes[:, 0].min()), int(boxes[:, 1].max())
+            c0, c1 = int(boxes[:, 2].min()), int(boxes[:, 3].max())
+            if c1 - c0 + 1 > self.max_size * W or r1 - r0 + 1 > self.max_size * H:
+                break  # too large for a ship already: no wider window
+            # reaching the window's edge (not the frame's): perhaps more of it beyond
+            edges = (win[1] > 0, win[3] < H, win[0] > 0, win[2] < W)
+            last = (win[3] - win[1] - 1, win[2] - win[0] - 1)
+            spill = (
+                (r0 == 0 and edges[0])
+                or (r1 == last[0] and edges[1])
+                or (c0 == 0 and edges[2])
+                or (c1 == last[1] and edges[3])
+            )
+            if not spill:
+                break
+            ext = (
+                min(ext[0], win[0] + c0),
+                min(ext[1], win[1] + r0),
+                max(ext[2], win[0] + c1 + 1),
+                max(ext[3], win[1] + r1 + 1),
+            )
+        inside = [
+            p
+            for p, b in zip(parts, boxes, strict=True)
+            if not (b[0] == 0 and edges[0])
+            and not (b[1] == last[0] and edges[1])
+            and not (b[2] == 0 and edges[2])
+            and not (b[3] == last[1] and edges[3])
+        ]
+        out: list[tuple[float, float, float, float, float, float, float]] = []
+        for group in _touching_groups(inside):
+            found = self._ships(fr, win, sum(group[1:], group[0]), absdiff, colour)
+            if found is None and len(group) > 1:  # no ship as a whole: its parts alone
+                found = []  # (a dark hull touching a bright glint patch)
+                for part in group:
+                    found += self._ships(fr, win, part, absdiff, colour) or []
+            out += found or []
+        return out
+
+    @staticmethod
+    def _ships(
+        fr: _Frame,
+        win: tuple[int, int, int, int],
+        mask: NDArray,
+        absdiff: NDArray,
+        colour: bool,
+        keep: bool = False,
+    ) -> list[tuple[float, float, float, float, float, float, float]] | None:
+        """Boxes, water-line points and areas of the ships in an object mask of the
+        window ``win`` (:func:`_frame_ships`), from its pixels that are at least half
+        covered: whose ``absdiff`` is at least half the largest within two pixels (the
+        smoothing's halo is no object; a thin mast or a partly covered pixel of the
+        hull's edge is, when more than half of it is covered), and at least a quarter of
+        the object's median on that row (a faint pixel that is its own neighbourhood's
+        largest — a wave trough run on from the hull's end — is no object either). None
+        when it is no ship, unless ``keep``: then the whole mask with the bottom of its
+        central columns as the water line."""
+        r0, r1, c0, c1 = _mask_extent(mask)
+        r0, c0 = max(0, r0 - 2), max(0, c0 - 2)
+        m = mask[r0 : r1 + 3, c0 : c1 + 3]
+        obj = np.where(m, absdiff[r0 : r1 + 3, c0 : c1 + 3], np.float32(0.0)).astype(np.float32)
+        with warnings.catch_warnings():  # rows without object pixels: NaN, no level
+            warnings.simplefilter("ignore", RuntimeWarning)
+            level = np.nanmedian(np.where(m, obj, np.nan), axis=1)
+        half = m & (obj >= 0.5 * cv2.dilate(obj, np.ones((5, 5), np.uint8)))
+        half &= obj >= 0.25 * np.nan_to_num(level)[:, None]
+        if half.any():
+            mask = np.zeros_like(mask)
+            mask[r0 : r1 + 3, c0 : c1 + 3] = half
+        r0, r1, c0, c1 = _mask_extent(mask)
+        X0, Y0 = win[0] + c0, win[1] + r0
+        obj_box = mask[r0 : r1 + 1, c0 : c1 + 1]
+        ships = _frame_ships(fr, obj_box, X0, Y0, colour)
+        if not ships:
+            if not keep:
+                return None
+            ships = [(0, obj_box.shape[1] - 1, 0, obj_box.shape[0] - 1, None, None)]
+        out = []
+        for sc0, sc1, sr0, sr1, u, v in ships:
+            ship = obj_box[sr0 : sr1 + 1, sc0 : sc1 + 1]
+            x, y = X0 + sc0 - 0.5, Y0 + sr0 - 0.5
+            if u is None or v is None:  # no measurable hull/sea edge: the mask's bottom
+                uu, vv = _waterline(ship)
+                u, v = x + uu, y + vv
+            w, h = float(sc1 - sc0 + 1), float(sr1 - sr0 + 1)
+            out.append((x, y, w, h, u, v, float(np.count_nonzero(ship))))
+        return out
+
+    def _refine_mask(
+        self, c: _Candidate, lv: _Level, fr: _Frame
+    ) -> list[tuple[float, float, float, float, float, float, float]]:
+        """``refine="mask"``: the objects of a candidate from its level's own contrast
+        (class docstring, step 5): in the candidate's box plus a margin (a quarter of
+        its height and the level's factor, at least two working pixels), the pixels
+        whose noise-normalised contrast against the level's CFAR backgrounds (luma and
+        chroma) exceeds 0.4 × its 95th percentile over the candidate, in the components
+        that touch the candidate; then :meth:`_ships` (half-covered pixels, sub-pixel
+        water line, ships whose water lines jump)."""
         sx, sy = fr.sx, fr.sy
         H, W = fr.shape
         bx0, by0, bx1, by1 = fr.box_to_work(c.box)  # unsheared working pixels
@@ -1347,7 +1544,7 @@ class ClassicalShipDetector:
         fy0 = max(0, math.floor((by0 - m) * sy))
         fy1 = min(H, math.ceil((by1 + 1 + m) * sy))
         if fx1 - fx0 < 2 or fy1 - fy0 < 2:
-            return None
+            return []
         # the level's backgrounds, sampled at the crop's pixel centres
         f = lv.factor
         cw = (np.arange(fx0, fx1, dtype=np.float32) + 0.5) / sx - 0.5  # working columns
@@ -1372,17 +1569,20 @@ class ClassicalShipDetector:
         else:
             res = np.maximum(g - hi, lo - g)
         res /= cv2.remap(lv.sigma, mx, my, **remap)  # in noise units, like z
+        chroma = False
         if lv.chroma and fr.colour is not None:
             col = np.ascontiguousarray(fr.colour[gy0:gy1, gx0:gx1])
             ycc = cv2.cvtColor(col, cv2.COLOR_BGR2YCrCb).astype(np.float32)
             ycc = cv2.GaussianBlur(ycc, (3, 3), 0.8, borderType=cv2.BORDER_REPLICATE)[inner]
             cx, cy = (mx + 0.5) / 2 - 0.5, (my + 0.5) / 2 - 0.5  # half-resolution planes
+            luma = res.copy()
             for ch_index, hc, lc, sc in lv.chroma:
                 gc = ycc[:, :, ch_index]
                 hi_c = cv2.remap(hc, cx, cy, **remap)
                 lo_c = cv2.remap(lc, cx, cy, **remap)
                 rc = np.maximum(gc - hi_c, lo_c - gc) / cv2.remap(sc, cx, cy, **remap)
                 np.maximum(res, rc, out=res)
+            chroma = bool(np.any(res > luma + 1e-6))
         # the candidate's own pixels (no margin)
         cx0 = max(0, math.floor(bx0 * sx) - fx0)
         cx1 = min(fx1 - fx0, math.ceil((bx1 + 1) * sx) - fx0)
@@ -1390,24 +1590,679 @@ class ClassicalShipDetector:
         cy1 = min(fy1 - fy0, math.ceil((by1 + 1) * sy) - fy0)
         core = res[cy0:cy1, cx0:cx1]
         if core.size == 0:
-            return None
+            return []
         peak = _percentile(core, 95.0) if core.size >= 20 else float(core.max())
         if peak <= 0:
-            return None
+            return []
         obj = (res > 0.4 * peak).view(np.uint8)
         n, labels = cv2.connectedComponents(obj, connectivity=8)
         touching = np.zeros(n, dtype=bool)
         touching[labels[cy0:cy1, cx0:cx1].ravel()] = True
         touching[0] = False
         if not touching.any():
-            return None
+            return []
         sel = touching[labels] if n > 2 else labels > 0
-        rr, cc = np.nonzero(sel)
-        r0, r1, c0, c1 = int(rr.min()), int(rr.max()), int(cc.min()), int(cc.max())
-        x, y = fx0 + c0 - 0.5, fy0 + r0 - 0.5
-        w, h = float(c1 - c0 + 1), float(r1 - r0 + 1)
-        u, v = _waterline(sel[r0 : r1 + 1, c0 : c1 + 1])
-        return x, y, w, h, x + u, y + v, float(rr.size)
+        win = (fx0, fy0, fx1, fy1)
+        return self._ships(fr, win, sel, np.maximum(res, 0.0), chroma, keep=True) or []
+
+    def _segment(
+        self,
+        fr: _Frame,
+        lv: _Level,
+        inner: tuple[int, int, int, int],
+        flanks: tuple[tuple[int, int], tuple[int, int]],
+        core: tuple[int, int, int, int],
+    ) -> tuple[list[NDArray[np.bool_]], NDArray, bool]:
+        """Object parts in the full-frame region ``inner`` = (x0, y0, x1, y1) [px, x1/y1
+        exclusive] around a candidate whose own pixels are ``core`` (same form).
+
+        Background ``b``: per line parallel to the horizon, the medians of the flanks —
+        the column ranges ``flanks`` (left, right; about :data:`_FLANK_SAMPLES` columns
+        of each, :func:`_line_samples`, :func:`_flank_stats`) — linear in the column
+        between them (:func:`_line_values`): the sea (or sky) on both sides of the
+        object. Residual ``g − b`` smoothed by a 3 × 3 Gaussian (σ = 0.8 px), divided per
+        row by the robust spread (1.4826 · MAD) of the flanks about their medians — the
+        larger of the whole flanks' and that of the row's line and its neighbours (a
+        horizon or cloud edge that the background does not follow exactly) — scaled by
+        the smoothing's share of the noise (the ratio of the smoothed and unsmoothed
+        residuals' spreads in the region): the statistic ``z``, bright (``z > 0``) and
+        dark (``z < 0``) apart. For colour frames whose candidate stands
+        out in chroma rather than luma, the level's chroma statistic joins in
+        (``max(|z|, z_chroma)``, one part without polarity).
+
+        Parts: per polarity (as configured), the 8-connected components of
+        ``|z| ≥ max(grow_threshold, 0.4 · peak)`` that hold a pixel of the candidate
+        with ``|z| ≥ max(threshold − 1, 0.5 · peak)``, ``peak`` the 95th percentile of
+        ``|z|`` over the candidate's own pixels, plus the significant pieces of
+        ``|z| ≥ max(grow_threshold, 0.2 · peak)`` attached to them (:meth:`_attach`: a
+        superstructure or a mast of less contrast than the hull). Returns the parts
+        (masks of ``inner``), the distance of each pixel from the background (``|g − b|``,
+        or in (Y, Cr, Cb) where chroma joined in), whose half-covered pixels give an
+        object's box, and whether it is a colour distance.
+        """
+        X0, Y0, X1, Y1 = inner
+        nr, nc = Y1 - Y0, X1 - X0
+        empty = np.zeros((0, 0), np.float32)
+        if nr < 2 or nc < 2:
+            return [], empty, False
+        slope = 0.0  # the horizon's slope [frame rows per column]
+        if fr.off is not None and fr.off.size > 1:
+            slope = float(fr.off[-1] - fr.off[0]) / (fr.off.size - 1) * fr.sy / fr.sx
+            if abs(slope) * (flanks[1][1] - flanks[0][0]) < 0.25:
+                slope = 0.0
+        cm = 0.5 * (X0 + X1 - 1)
+        (la, lb), (ra_, rb_) = flanks
+        lc = np.arange(la, lb, max(1, (lb - la) // _FLANK_SAMPLES))
+        rc = np.arange(ra_, rb_, max(1, (rb_ - ra_) // _FLANK_SAMPLES))
+        if lc.size + rc.size < 8:  # no room for flanks (a frame-wide object): the region
+            lc, rc = np.arange(X0, X1, max(1, nc // _FLANK_SAMPLES)), np.zeros(0, int)
+        cols = np.r_[lc, rc].astype(np.intp)
+        samples = _line_samples(fr, Y0, nr, cols, slope * (cols - cm), colour=False)
+        meds, spread_raw, sigma_raw = _flank_stats(samples, lc.size)
+        xs = np.arange(X0, X1)
+        dx = slope * (xs - cm)
+        raw = fr.grey_crop(Y0, Y1, X0, X1)
+        diff = raw - _line_values(meds, lc, rc, xs, dx)
+        res = cv2.GaussianBlur(diff, (3, 3), 0.8, borderType=cv2.BORDER_REPLICATE)
+        lo_v, hi_v = cv2.minMaxLoc(raw)[:2]
+        floor = max(0.3 * fr.quantum, 1e-4 * (hi_v - lo_v), 1e-12)
+        # the smoothing's share of the noise (estimated in the region, where the object
+        # inflates both spreads alike), applied to the flanks' clean spreads
+        kappa = min(1.0, _mad(res[::2, ::2]) / max(_mad(diff[::2, ::2]), 1e-12))
+        sigma = max(kappa * sigma_raw, floor)
+        line_sigma = np.maximum(kappa * spread_raw, sigma).astype(np.float32)
+        zs = res * (1.0 / line_sigma)[:, None]  # signed
+        pol = {"both": (1.0, -1.0), "bright": (1.0,), "dark": (-1.0,)}[self.polarity]
+        zl = np.abs(zs) if len(pol) == 2 else np.maximum(pol[0] * zs, 0.0)
+        ca, ra, cb, rb = core[0] - X0, core[1] - Y0, core[2] - X0, core[3] - Y0
+        zlc = zl[ra:rb, ca:cb]
+        if zlc.size == 0:
+            return [], empty, False
+        luma_peak = _percentile(zlc, 95.0) if zlc.size >= 20 else float(zlc.max())
+        z, peak, chroma = zl, luma_peak, False
+        if lv.chroma and fr.colour is not None:  # chroma, where it may carry the candidate
+            zc_chroma = self._chroma_z(fr, lv, core)
+            if zc_chroma.size and float(zc_chroma.max()) > 0.5 * float(zlc.max()):
+                chroma = True
+                z = np.maximum(zl, self._chroma_z(fr, lv, inner))
+                zc = z[ra:rb, ca:cb]
+                peak = _percentile(zc, 95.0) if zc.size >= 20 else float(zc.max())
+        grow = max(self.grow_threshold, 0.2 * peak)
+        seed = max(self.threshold - 1.0, 0.5 * peak)
+        strict = max(self.grow_threshold, 0.4 * peak)
+        if peak < seed:
+            return [], empty, False
+        luma = luma_peak >= 0.5 * peak  # luma carries the object
+        planes = [np.maximum(p * zs, 0.0) for p in pol] if luma else [z]
+        parts: list[NDArray[np.bool_]] = []
+        for zp in planes:
+            n, labels = cv2.connectedComponents((zp >= strict).view(np.uint8), connectivity=8)
+            seeded = np.zeros(n, dtype=bool)
+            seeded[labels[ra:rb, ca:cb][zp[ra:rb, ca:cb] >= seed]] = True
+            seeded[0] = False
+            if not seeded.any():
+                continue
+            sel = seeded[labels]
+            if luma and grow < strict:
+                sel = self._attach(zp, sel, grow, strict)
+            n, labels = cv2.connectedComponents(sel.view(np.uint8), connectivity=8)
+            parts += [labels == k for k in range(1, n)]
+        if not parts or not chroma:  # luma shows it: its distance is luma's
+            return parts, np.abs(diff), False
+        # colour: the distance from the background in (Y, Cr, Cb), so that a hull of the
+        # sea's luma but not its colour under a bright cabin is no less the ship's; only
+        # where the parts are (and two pixels around)
+        union = parts[0] if len(parts) == 1 else np.logical_or.reduce(parts)
+        r0, r1, c0, c1 = _mask_extent(union)
+        r0, c0, r1, c1 = max(0, r0 - 2), max(0, c0 - 2), min(nr, r1 + 3), min(nc, c1 + 3)
+        ycc_s = _line_samples(fr, Y0, nr, cols, slope * (cols - cm), colour=True)
+        crop = np.ascontiguousarray(fr.colour[Y0 + r0 : Y0 + r1, X0 + c0 : X0 + c1])
+        ycc = cv2.cvtColor(crop, cv2.COLOR_BGR2YCrCb).astype(np.float32)
+        dist = np.zeros((nr, nc), np.float32)
+        part_d = diff[r0:r1, c0:c1]
+        acc = part_d * part_d
+        for ch in (1, 2):
+            m_ch = _flank_stats(np.ascontiguousarray(ycc_s[:, :, ch]), lc.size)[0]
+            bg_ch = _line_values(m_ch, lc, rc, xs[c0:c1], dx[c0:c1])[r0:r1]
+            dc = ycc[:, :, ch] - bg_ch
+            acc += dc * dc
+        dist[r0:r1, c0:c1] = np.sqrt(acc)
+        return parts, dist, True
+
+    @staticmethod
+    def _attach(z: NDArray, obj: NDArray[np.bool_], low: float, strict: float) -> NDArray:
+        """``obj`` plus the pieces of ``z ≥ low`` attached to it that are significant as a
+        whole, ``Σ (z − low) ≥ 2 · strict`` over the piece, not wholly under it and not
+        reaching past its columns by more than an eighth of its width (2 px at least) —
+        a superstructure, a mast or the end of a hull of less contrast than the rest
+        joins; a few noise or clutter pixels next to the object, a wave crest, wake or
+        reflection under its water line, or a wave trough running on beside it, do
+        not."""
+        n, labels = cv2.connectedComponents((z >= low).view(np.uint8), connectivity=8)
+        hold = np.zeros(n, dtype=bool)
+        hold[labels[obj]] = True
+        hold[0] = False
+        extra = hold[labels] & ~obj
+        if not extra.any():
+            return obj
+        k, parts = cv2.connectedComponents(extra.view(np.uint8), connectivity=8)
+        weight = np.bincount(parts.ravel(), weights=(z - low).ravel(), minlength=k)
+        good = weight >= 2.0 * strict
+        good[0] = False
+        if good.any():
+            rows = np.arange(obj.shape[0])[:, None]
+            has = obj.any(axis=0)
+            low_row = np.where(has, np.max(np.where(obj, rows, -1), axis=0), -1)
+            rr, cc = np.nonzero(parts)
+            pk = parts[rr, cc]
+            # under the water line: every pixel below obj's lowest in its column
+            above = (low_row[cc] < 0) | (rr <= low_row[cc])
+            good &= np.bincount(pk, weights=above, minlength=k) > 0
+            # running on beside it (a wave trough, a glint streak): past obj's columns
+            cols = np.flatnonzero(has)
+            slack = max(2, (cols[-1] - cols[0] + 1) // 8)
+            out = (cc < cols[0] - slack) | (cc > cols[-1] + slack)
+            good &= np.bincount(pk, weights=out, minlength=k) == 0
+        return obj | good[parts]
+
+    def _chroma_z(self, fr: _Frame, lv: _Level, win: tuple[int, int, int, int]) -> NDArray:
+        """The chroma statistic of the finest level (class docstring, step 3), at the
+        full-resolution pixels of the window ``win`` (its CFAR backgrounds and noise
+        sampled there)."""
+        X0, Y0, X1, Y1 = win
+        H, W = fr.shape
+        cw = (np.arange(X0, X1, dtype=np.float32) + 0.5) / fr.sx - 0.5  # working columns
+        rw = (np.arange(Y0, Y1, dtype=np.float32) + 0.5) / fr.sy - fr.wtop  # band edge rows
+        mx, my = np.meshgrid(cw, rw - 0.5)
+        if fr.off is not None:
+            shift = np.interp(cw, np.arange(fr.off.size), fr.off).astype(np.float32)
+            my -= shift[None, :]
+        gx0, gy0 = max(0, X0 - 1), max(0, Y0 - 1)
+        gx1, gy1 = min(W, X1 + 1), min(H, Y1 + 1)
+        inner = (slice(Y0 - gy0, Y1 - gy0), slice(X0 - gx0, X1 - gx0))
+        assert fr.colour is not None and lv.chroma is not None
+        col = np.ascontiguousarray(fr.colour[gy0:gy1, gx0:gx1])
+        ycc = cv2.cvtColor(col, cv2.COLOR_BGR2YCrCb).astype(np.float32)
+        ycc = cv2.GaussianBlur(ycc, (3, 3), 0.8, borderType=cv2.BORDER_REPLICATE)[inner]
+        cx, cy = (mx + 0.5) / 2 - 0.5, (my + 0.5) / 2 - 0.5  # half-resolution planes
+        remap = {"interpolation": cv2.INTER_LINEAR, "borderMode": cv2.BORDER_REPLICATE}
+        out = np.zeros(mx.shape, np.float32)
+        for ch_index, hc, lc, sc in lv.chroma:
+            gc = ycc[:, :, ch_index]
+            hi_c = cv2.remap(hc, cx, cy, **remap)
+            lo_c = cv2.remap(lc, cx, cy, **remap)
+            rc = np.maximum(gc - hi_c, lo_c - gc) / cv2.remap(sc, cx, cy, **remap)
+            np.maximum(out, rc, out=out)
+        return out
+
+
+def _mad(a: NDArray) -> float:
+    """Robust spread ``1.4826 · median(|a − median(a)|)`` of the values ``a``."""
+    a = a.ravel()
+    return 1.4826 * float(np.median(np.abs(a - np.median(a))))
+
+
+@njit(cache=True, nogil=True)
+def _flank_kernel(samples, n_left, meds, spread):  # pragma: no cover - compiled
+    """Per row of ``samples`` (rows, n): the median of the first ``n_left`` values and of
+    the rest (NaN for an empty side) into ``meds`` (rows, 2), and the median absolute
+    deviation of all values from their side's median into ``spread`` (rows,)."""
+    rows, n = samples.shape
+    buf = np.empty(n, np.float64)
+    dev = np.empty(n, np.float64)
+    for r in range(rows):
+        for side in range(2):
+            a = 0 if side == 0 else n_left
+            b = n_left if side == 0 else n
+            if b <= a:
+                meds[r, side] = np.nan
+                continue
+            for j in range(a, b):
+                buf[j - a] = samples[r, j]
+            meds[r, side] = np.median(buf[: b - a])
+            for j in range(a, b):
+                dev[j] = abs(samples[r, j] - meds[r, side])
+        spread[r] = np.median(dev[:n])
+
+
+def _flank_stats(samples: NDArray, n_left: int) -> tuple[list[NDArray | None], NDArray, float]:
+    """Per line of the flank samples (:func:`_line_samples`; the first ``n_left`` columns
+    the left flank's): the two flanks' medians (None for an empty flank), the robust
+    spread about them (1.4826 · MAD, the largest of each line's and its neighbours') and
+    the robust spread of all samples (the background's noise) [units]."""
+    rows = samples.shape[0]
+    meds = np.empty((rows, 2))
+    spread = np.empty(rows)
+    _flank_kernel(np.ascontiguousarray(samples, dtype=np.float32), n_left, meds, spread)
+    spread *= 1.4826
+    overall = float(np.median(spread))
+    spread = np.maximum(spread, np.maximum(np.r_[spread[1:], 0.0], np.r_[0.0, spread[:-1]]))
+    out = [None if np.isnan(meds[0, k]) else meds[:, k].astype(np.float32) for k in (0, 1)]
+    return out, spread, overall
+
+
+def _line_samples(fr: _Frame, y0: int, nr: int, cols: NDArray, d: NDArray, colour: bool) -> NDArray:
+    """Frame values on lines parallel to the horizon at the columns ``cols``: line ``r``
+    (0 … nr − 1) meets column ``cols[j]`` at frame row ``y0 + r + d[j]`` (linear between
+    rows, edge rows repeated). Grey (nr, n), or (Y, Cr, Cb) (nr, n, 3) with ``colour``."""
+    H = fr.shape[0]
+    lo = math.floor(float(d.min())) if d.size else 0
+    hi = math.ceil(float(d.max())) + 1 if d.size else 1
+    rows = np.clip(np.arange(y0 + lo, y0 + nr + hi), 0, H - 1)
+    a, b = int(rows[0]), int(rows[-1]) + 1  # rows is a clipped run: a slice, repeated
+    if colour:
+        assert fr.colour is not None
+        block = np.take(fr.colour[a:b], cols, axis=1)
+        block = cv2.cvtColor(block, cv2.COLOR_BGR2YCrCb)
+    else:
+        block = np.take(fr.grey_rows(a, b), cols, axis=1)
+    block = block[rows - a].astype(np.float32)
+    if not np.any(d):
+        return block[-lo : -lo + nr]
+    pos = np.arange(nr, dtype=np.float32)[:, None] + (d - lo).astype(np.float32)[None, :]
+    i0 = np.clip(np.floor(pos).astype(np.intp), 0, block.shape[0] - 2)
+    f = np.clip(pos - i0, 0.0, 1.0)
+    j = np.arange(cols.size)[None, :]
+    if block.ndim == 3:
+        f = f[:, :, None]
+    return block[i0, j] * (1.0 - f) + block[i0 + 1, j] * f
+
+
+def _line_values(
+    meds: list[NDArray | None], lc: NDArray, rc: NDArray, xs: NDArray, d: NDArray
+) -> NDArray:
+    """The background (nr, len(xs)) at frame columns ``xs`` whose rows lie ``d`` below
+    their lines' (see :func:`_line_samples`), from the per-line medians of the left
+    flank (columns ``lc``) and the right one (``rc``): linear in the column between the
+    flanks' centres (a horizontal gradient of the sea or sky — a glint path, haze — is
+    followed; outside them it keeps the nearer flank's value); one flank, or flanks of
+    fewer than four columns, give one value per line."""
+    left, right = meds
+    if left is None or right is None or lc.size < 4 or rc.size < 4:
+        both = [m for m in meds if m is not None]
+        left = right = both[0] if len(both) == 1 else 0.5 * (both[0] + both[1])
+        t = np.zeros(xs.size, np.float32)
+    else:
+        cl, cr = float(lc.mean()), float(rc.mean())
+        t = np.clip((xs - cl) / (cr - cl), 0.0, 1.0).astype(np.float32)
+    nr = left.shape[0]
+    lines = (left[:, None] + (right - left)[:, None] * t[None, :]).astype(np.float32)
+    if not np.any(d):
+        return lines
+    cx = np.broadcast_to(np.arange(xs.size, dtype=np.float32)[None, :], lines.shape)
+    cy = np.arange(nr, dtype=np.float32)[:, None] - d.astype(np.float32)[None, :]
+    return cv2.remap(lines, cx, cy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+
+
+def _distinct(rows: NDArray, overlap: float = 0.7, wl_tol: float = 0.5) -> NDArray[np.intp]:
+    """Indices (in the given order) of the detections (rows of :data:`DETECTION_COLUMNS`)
+    that are no part of another: taken largest box first, a detection is dropped when
+    more than ``overlap`` of its box lies inside a kept box and its water line is not
+    more than ``wl_tol`` [px] below that one's (two candidates that refined to one ship,
+    or a superstructure boxed alone; a ship in front of another has its own, lower,
+    water line and stays)."""
+    order = np.argsort(-(rows[:, 2] * rows[:, 3]), kind="stable")
+    keep: list[int] = []
+    for i in order.tolist():
+        x, y, w, h = rows[i, :4]
+        dup = False
+        for j in keep:
+            X, Y, Wj, Hj = rows[j, :4]
+            iw = min(x + w, X + Wj) - max(x, X)
+            ih = min(y + h, Y + Hj) - max(y, Y)
+            if (
+                iw > 0
+                and ih > 0
+                and iw * ih > overlap * w * h
+                and rows[i, 6] <= rows[j, 6] + wl_tol
+            ):
+                dup = True
+                break
+        if not dup:
+            keep.append(i)
+    return np.array(sorted(keep), dtype=np.intp)
+
+
+def _mask_extent(mask: NDArray[np.bool_]) -> tuple[int, int, int, int]:
+    """Inclusive extent ``(r0, r1, c0, c1)`` of a non-empty mask."""
+    rr = np.flatnonzero(mask.any(axis=1))
+    cc = np.flatnonzero(mask.any(axis=0))
+    return int(rr[0]), int(rr[-1]), int(cc[0]), int(cc[-1])
+
+
+def _touching_groups(parts: list[NDArray[np.bool_]]) -> list[list[NDArray[np.bool_]]]:
+    """The groups of masks that touch (8-neighbours) or stack: overlapping columns
+    with at most ``max(2, h/4)`` rows between them (``h`` the shorter part's height; a
+    superstructure over its hull across a faint line, such as the horizon's), taken
+    transitively."""
+    if len(parts) < 2:
+        return [[p] for p in parts]
+    ext = [_mask_extent(p) for p in parts]
+    grown = []
+    for p, (r0, r1, _, _) in zip(parts, ext, strict=True):
+        k = 1 + 2 * max(2, (r1 - r0 + 1) // 4)
+        grown.append(cv2.dilate(p.view(np.uint8), np.ones((k, 3), np.uint8)) > 0)
+    group = list(range(len(parts)))
+
+    def root(i: int) -> int:
+        while group[i] != i:
+            group[i] = group[group[i]]
+            i = group[i]
+        return i
+
+    for i in range(len(parts)):
+        for j in range(i + 1, len(parts)):
+            if root(i) != root(j) and np.any(grown[i] & parts[j]):
+                group[root(j)] = root(i)
+    out: dict[int, list[NDArray[np.bool_]]] = {}
+    for i, p in enumerate(parts):
+        out.setdefault(root(i), []).append(p)
+    return list(out.values())
+
+
+_FLANK_SAMPLES = 32
+"""Columns per flank (at most about) whose medians give a window's background."""
+
+_WL_BELOW = 6
+"""Rows of sea under an object's lowest mask pixel that :func:`_edge_waterline` reads."""
+
+_WL_RAGGED = 1.0
+"""Largest robust spread [px] of a ship's per-column water-line edges about their line:
+a hull meets the sea along a straight (or gently bending) edge; a patch of sun glitter,
+a whitecap or a cloud's bottom does not."""
+
+_WL_MIN_COLUMNS = 16
+"""Hull columns from which an object without a measurable water line is no ship."""
+
+
+def _column_edges(
+    raw: NDArray, obj: NDArray[np.bool_], quantum: float = 0.0
+) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """Per column of an object mask: the column, its lowest and highest mask rows and its
+    sub-pixel hull/sea edge [px, rows of ``raw``] (NaN where too faint to measure; see
+    :func:`_edge_waterline`). ``raw`` is the unsmoothed (H, W) grey or (H, W, C) colour
+    crop under the mask (rows past it repeat its last row). For colour, each pixel is
+    projected on the axis from the sea's colour to the hull's, ``(c − c_s)·(c_h − c_s) /
+    |c_h − c_s|²`` (linear in the hull's coverage of the pixel, like the grey level)."""
+    H = obj.shape[0]
+    cols = np.flatnonzero(obj.any(axis=0))
+    bottom = H - 1 - np.argmax(obj[::-1, cols], axis=0)
+    top = np.argmax(obj[:, cols], axis=0)
+    g = raw if raw.dtype == np.float32 else raw.astype(np.float32)
+    if g.ndim == 2:
+        g = g[:, :, None]
+    nch = g.shape[2]
+
+    def at(r: NDArray) -> NDArray:  # (columns, channels)
+        return g[np.clip(r, 0, H - 1), cols]
+
+    sea = np.stack([at(bottom + k) for k in (3, 4, 5)])
+    i_s = np.median(sea, axis=0)
+    sigma = max(1.4826 * float(np.median(np.abs(sea - i_s))), quantum, 1e-6)
+    start = bottom - 1  # the transition window: rows b_c - 1 ... b_c + 2
+    above = np.stack([at(start - k) for k in (1, 2, 3)])
+    n_in = ((start - 1) >= top).astype(int) + ((start - 2) >= top) + ((start - 3) >= top)
+    n_in = n_in[:, None]
+    i_h = np.where(
+        n_in >= 3,
+        np.median(above, axis=0),
+        np.where(n_in == 2, 0.5 * (above[0] + above[1]), above[0]),
+    )
+    thin = n_in[:, 0] == 0
+    if thin.any():  # no mask row above the window: the most contrasted mask pixel
+        span = np.stack([at(bottom - k) for k in (0, 1, 2)])
+        inside = np.stack([(bottom - k) >= top for k in (0, 1, 2)])
+        dist = np.sqrt(np.sum((span - i_s) ** 2, axis=2))
+        pick = np.argmax(np.where(inside, dist, -1.0), axis=0)
+        i_h = np.where(thin[:, None], span[pick, np.arange(cols.size)], i_h)
+        start = np.where(thin, bottom - pick, start)
+    axis = i_h - i_s
+    norm2 = np.sum(axis * axis, axis=1)
+    weak = norm2 < (4.0 * sigma) ** 2 * nch
+    axis = np.where(weak[:, None], 0.0, axis / np.where(weak, 1.0, norm2)[:, None])
+    edge = start - 0.5
+    for k in range(6):  # window rows start … b_c + 2 (at most 6)
+        r = start + k
+        cov = np.clip(np.sum((at(r) - i_s) * axis, axis=1), 0.0, 1.0)
+        edge = edge + np.where(r <= bottom + 2, cov, 0.0)
+    return cols, bottom, top, np.where(weak, np.nan, edge)
+
+
+def _theil_sen(x: NDArray, y: NDArray, u: float) -> tuple[float, float, float]:
+    """The Theil–Sen line through ``(x, y)`` (median of the pairwise slopes of at most 24
+    evenly spread points; median intercept): its value at ``u``, its slope and the
+    robust spread of the residuals about it (1.4826 · MAD)."""
+    n = x.size
+    if n < 2:
+        return float(y[0]), 0.0, 0.0
+    sub = np.linspace(0, n - 1, 24).round().astype(int) if n > 24 else np.arange(n)
+    i, j = np.triu_indices(sub.size, 1)
+    dx = x[sub][j] - x[sub][i]
+    ok = dx != 0
+    slope = float(np.median((y[sub][j] - y[sub][i])[ok] / dx[ok])) if ok.any() else 0.0
+    r = y - slope * (x - u)
+    v = float(np.median(r))
+    return v, slope, 1.4826 * float(np.median(np.abs(r - v)))
+
+
+def _theil_sen_at(x: NDArray, y: NDArray, u: float) -> float:
+    """Value at ``u`` of the Theil–Sen line through ``(x, y)`` (:func:`_theil_sen`)."""
+    return _theil_sen(x, y, u)[0]
+
+
+def _edge_waterline(
+    raw: NDArray, obj: NDArray[np.bool_], quantum: float = 0.0
+) -> tuple[float, float] | None:
+    """Sub-pixel water-line point ``(u, v)`` [px] of one object, relative to the centre of
+    the top-left pixel of ``raw``; None when the hull/sea edge is too weak to measure.
+
+    ``raw`` is the unsmoothed grey crop and ``obj`` the object mask on it (same shape),
+    with :data:`_WL_BELOW` rows under the mask's lowest pixel (rows past the crop repeat
+    its last row). Hull columns: those whose lowest mask pixel ``b_c`` lies in the lowest
+    30 % of the object (masts, sails and superstructure stop higher). Per hull column:
+
+    * sea level ``I_s`` = median of rows ``b_c + 3 … b_c + 5``; hull level ``I_h`` = the
+      median of the mask rows among ``b_c − 2 … b_c − 4`` (the hull just above the
+      transition window ``r_s = b_c − 1 … b_c + 2``; two of three rows are hull when a
+      superstructure stands on a hull of four rows); a column of two mask rows or fewer
+      takes its most contrasted mask pixel as ``I_h`` and starts the window there;
+    * the edge is the coverage integral across the transition,
+      ``e_c = r_s − 1/2 + Σ_{r = r_s … b_c + 2} clip((g_r − I_s) / (I_h − I_s), 0, 1)``:
+      for an area-sampled step edge it is the edge's position exactly, and a symmetric
+      blur (lens, codec) moves intensity across the edge without changing the integral —
+      unlike the bottom of a thresholded mask, which moves with the threshold, the blur
+      and the pixel grid;
+    * columns whose contrast ``|I_h − I_s|`` is under 4 σ (σ = 1.4826 · MAD of the sea
+      rows about their column levels, at least ``quantum``) are left out.
+
+    The water line is a Theil–Sen line through the kept ``(c, e_c)`` (median of pairwise
+    slopes, median intercept: a hull seen at an angle slopes, and an occluding hull or a
+    wave crest under a minority of the columns does not move it), evaluated at ``u``, the
+    middle of the hull columns' extent (midship, for a hull seen side-on). None when
+    fewer than two columns, or fewer than a quarter of the hull columns, are kept.
+    """
+    if not obj.any():
+        return None
+    return _hull_waterline(*_column_edges(raw, obj, quantum))
+
+
+def _hull_waterline(
+    cols: NDArray, bottom: NDArray, top: NDArray, edge: NDArray
+) -> tuple[float, float] | None:
+    """The water-line point of :func:`_edge_waterline` from the per-column arrays of
+    :func:`_column_edges` (hull columns, Theil–Sen line at their middle)."""
+    rb = int(bottom.max())
+    hull = bottom >= rb - max(1, round(0.3 * (rb - int(top.min()) + 1)))
+    u = 0.5 * (float(cols[hull][0]) + float(cols[hull][-1]))
+    keep = hull & np.isfinite(edge)
+    n = int(keep.sum())
+    if n < max(2, 0.25 * int(hull.sum())):
+        return None
+    return u, _theil_sen_at(cols[keep].astype(np.float64), edge[keep], u)
+
+
+def _waterline_levels(
+    cols: NDArray,
+    edge: NDArray,
+    jump: float = 1.0,
+    hull: NDArray | None = None,
+    sigma: float = 0.0,
+) -> list[NDArray] | None:
+    """Columns of the ships in one object mask whose water line jumps: two ships at
+    different ranges, one in front of the other or side by side (the farther one's water
+    line is higher in the image). None for one ship.
+
+    Along the columns with a measured edge (``edge`` [px], NaN where none), a break is
+    where the medians of the three (running-median-smoothed) edges before and after
+    differ by at least ``J = max(jump, 4 σ)`` (σ the edges' noise, from the MAD of their
+    differences), one per transition; ``jump`` = 1 px: a hull whose darker stern is
+    drawn a pixel lower stays one ship in 99 % of the demo's frames, the ships of the
+    rendered meeting and overtaking cases at 960×540 (1.1–1.3 px apart) split in 77 %
+    and 68 % of theirs (0.8 px: 96 % of the demo's frames, 86 % and 100 %). Levels are
+    the runs between breaks of at least four columns whose Theil–Sen slope is at most
+    0.25 px per column (flat: a single hull's water line slopes, bends and rises to a
+    raked bow, but has no second flat level); levels within ``J / 2`` of each other
+    belong to one ship (the two visible ends of a ship behind a nearer one). Returns one
+    column-index array (into ``cols``) per ship of at least ``max(6, n / 4)`` columns
+    (``n`` measured columns: no ship is split off a hull's end), or None when there is
+    only one. With ``hull`` (the hull's level per column, :func:`_column_edges`), the
+    ships' hulls must also differ — by at least ``max(8 σ, 0.08 × the hulls' typical
+    contrast)`` (``sigma`` the noise): one hull whose drawn water line steps by a pixel
+    (a sloping edge rendered without anti-aliasing) stays one ship.
+    """
+    ok = np.flatnonzero(np.isfinite(edge))
+    n = ok.size
+    if n < 9:
+        return None
+    c, e = cols[ok], edge[ok]
+    em = e.copy()
+    em[1:-1] = np.median(np.stack([e[:-2], e[1:-1], e[2:]]), axis=0)
+    d = np.diff(e)
+    noise = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(2.0)
+    J = max(jump, 4.0 * noise)
+    # between columns i and i + 1: the medians of the three edges after and before
+    ext = np.r_[em[0], em[0], em, em[-1], em[-1]]
+    med = np.median(np.stack([ext[:-2], ext[1:-1], ext[2:]]), axis=0)  # centred, j = -1 … n
+    step = np.abs(med[3 : n + 2] - med[: n - 1])
+    step[np.diff(c) > 2] = 0.0
+    breaks = [
+        i for i in range(n - 1) if step[i] >= J and step[i] == step[max(0, i - 2) : i + 3].max()
+    ]
+    if not breaks:
+        return None
+    runs = []
+    for a, b in itertools.pairwise([0, *[k + 1 for k in breaks], n]):
+        if b - a >= 4:  # a level: four columns or more, flat
+            x = c[a:b].astype(np.float64)
+            if abs(_theil_sen(x, e[a:b], x[0])[1]) <= 0.25:
+                runs.append((a, b))
+    if len(runs) < 2:
+        return None
+    levels = sorted((float(np.median(e[a:b])), a, b) for a, b in runs)
+    groups: list[list[tuple[int, int]]] = [[(levels[0][1], levels[0][2])]]
+    last = levels[0][0]
+    for lev, a, b in levels[1:]:
+        if lev - last < 0.5 * J:
+            groups[-1].append((a, b))
+        else:
+            groups.append([(a, b)])
+        last = lev
+    out = [ok[np.concatenate([np.arange(a, b) for a, b in g])] for g in groups]
+    out = [g for g in out if g.size >= max(6, 0.25 * n)]
+    if len(out) < 2:
+        return None
+    if hull is not None:  # two ships: two hulls, of two colours or brightnesses
+        levels_h = np.array([np.median(hull[g], axis=0) for g in out])
+        norm = np.sqrt(np.sum(np.reshape(hull[ok], (ok.size, -1)) ** 2, axis=1))
+        spread = max(8.0 * sigma, 0.08 * float(np.median(norm)))
+        apart = [
+            np.sqrt(np.sum((levels_h[i] - levels_h[j]) ** 2)) >= spread
+            for i in range(len(out))
+            for j in range(i + 1, len(out))
+        ]
+        if not all(apart):
+            return None
+    return out
+
+
+def _frame_ships(
+    fr: _Frame, obj: NDArray[np.bool_], x0: int, y0: int, colour: bool = False
+) -> list[tuple[int, int, int, int, float | None, float | None]]:
+    """The ships of an object mask whose top-left pixel is frame pixel ``(x0, y0)``, read
+    from the full-resolution grey frame: per ship ``(c0, c1, r0, r1, u, v)``, its
+    columns and rows (inclusive, mask pixels) and its water-line point [frame px] (None
+    when too faint; :func:`_edge_waterline`). One ship unless the water line jumps
+    (:func:`_waterline_levels`): then per ship its columns' span, the rows of its columns
+    and the water line of its columns. None at all when the object is no ship: its
+    water-line edges scatter about their line by more than :data:`_WL_RAGGED` (sun
+    glitter, whitecaps), or it has at least :data:`_WL_MIN_COLUMNS` hull columns and
+    fewer than a quarter of them show a hull/sea edge."""
+    h, w = obj.shape
+    y1 = min(fr.shape[0], y0 + h + _WL_BELOW)
+    if colour and fr.colour is not None:  # (Y, Cr, Cb): a hull may differ in colour only
+        crop = np.ascontiguousarray(fr.colour[y0:y1, x0 : x0 + w])
+        raw = cv2.cvtColor(crop, cv2.COLOR_BGR2YCrCb).astype(np.float32)
+    else:
+        raw = fr.grey_crop(y0, y1, x0, x0 + w)
+    mask = np.zeros(raw.shape[:2], dtype=bool)
+    mask[:h] = obj
+    cols, bottom, top, edge = _column_edges(raw, mask, fr.quantum)
+    # the hull's colour (Y, Cr, Cb; grey for a grey frame) per column, from the sea's
+    if fr.colour is not None and not colour:
+        crop = np.ascontiguousarray(fr.colour[y0:y1, x0 : x0 + w])
+        rgb = cv2.cvtColor(crop, cv2.COLOR_BGR2YCrCb).astype(np.float32)
+    else:
+        rgb = raw if raw.ndim == 3 else raw[:, :, None]
+    last = rgb.shape[0] - 1
+    pick = [rgb[np.clip(bottom + k, 0, last), cols] for k in (-3, -2, -2, 3, 4, 5)]
+    hull = np.median(np.stack(pick[:3]), axis=0) - np.median(np.stack(pick[3:]), axis=0)
+    sea_rows = np.stack(pick[3:])
+    noise = 1.4826 * float(np.median(np.abs(sea_rows - np.median(sea_rows, axis=0))))
+    groups = _waterline_levels(cols, edge, hull=hull, sigma=max(noise, 0.5 * fr.quantum))
+    if groups is None:
+        rb = int(bottom.max())
+        hull = bottom >= rb - max(1, round(0.3 * (rb - int(top.min()) + 1)))
+        keep = hull & np.isfinite(edge)
+        n_hull = int(hull.sum())
+        if int(keep.sum()) < max(2, 0.25 * n_hull):
+            if n_hull >= _WL_MIN_COLUMNS:
+                return []  # a large object without a water line: not a ship
+            return [(0, w - 1, 0, h - 1, None, None)]
+        u = 0.5 * (float(cols[hull][0]) + float(cols[hull][-1]))
+        v, _, ragged = _theil_sen(cols[keep].astype(np.float64), edge[keep], u)
+        if ragged > _WL_RAGGED:
+            return []
+        return [(0, w - 1, 0, h - 1, x0 + u, y0 + v)]
+    fits = []
+    for g in groups:
+        x = cols[g].astype(np.float64)
+        v, slope, ragged = _theil_sen(x, edge[g], float(x.mean()))
+        if ragged > _WL_RAGGED:
+            return []
+        fits.append((float(x.mean()), v, slope))
+    # every column with an edge joins the ship whose water line passes nearest (a bow
+    # rising from a level, a transition column); the far ship spans the near one
+    line = np.stack([v + k * (cols - m) for m, v, k in fits])
+    meas = np.isfinite(edge)
+    near = np.where(meas, np.argmin(np.abs(line - np.where(meas, edge, 0.0)), axis=0), -1)
+    # the levels must describe the object's water line: most columns on them, and the
+    # rest near one (a glint patch's ragged bottom has flat stretches too)
+    resid = edge[meas] - line[near[meas], np.flatnonzero(meas)]
+    on_levels = sum(g.size for g in groups)
+    if on_levels < 0.5 * meas.sum() or 1.4826 * float(np.median(np.abs(resid))) > _WL_RAGGED:
+        return []
+    out: list[tuple[int, int, int, int, float | None, float | None]] = []
+    for k, g in enumerate(groups):
+        own = near == k
+        own[g] = True
+        c0, c1 = int(cols[own].min()), int(cols[own].max())
+        span = (cols >= c0) & (cols <= c1)
+        r0 = int(top[span].min()) if k == 0 else int(top[own].min())
+        r1 = int(bottom[own].max())
+        u = 0.5 * (c0 + c1)
+        m, v, slope = fits[k]
+        out.append((c0, c1, r0, r1, x0 + u, y0 + v + slope * (u - m)))
+    return out
 
 
 def _waterline(obj: NDArray[np.bool_]) -> tuple[float, float]:
@@ -1441,9 +2296,11 @@ def waterline_points(image: ArrayLike, xywh: ArrayLike) -> FloatArray:
     the box width each, at least 4 px) on that row; the object is the pixels inside the
     box (and ``max(2, h/4)`` rows below it) whose absolute difference from it exceeds
     ``max(3 σ, 0.4 · p95)`` (σ = 1.4826 · MAD of the strips' residuals, p95 = the 95th
-    percentile of the box's differences); the water-line point is the bottom edge of the
-    lowest object pixel within the central half of the box's columns, as for
-    :class:`ClassicalShipDetector`. A box with no such pixels keeps its bottom centre
+    percentile of the box's differences); the water-line point is the sub-pixel hull/sea
+    edge of that object, as for :class:`ClassicalShipDetector` (coverage integral per hull
+    column, Theil–Sen line evaluated at the middle of the hull; the bottom edge of the
+    lowest object pixel within the central half of the box's columns when the edge is too
+    weak to measure). A box with no such pixels keeps its bottom centre
     ``(x + w/2, y + h)``.
 
     Args:
@@ -1453,7 +2310,7 @@ def waterline_points(image: ArrayLike, xywh: ArrayLike) -> FloatArray:
     Returns:
         (N, 2) array of ``(u_wl, v_wl)`` [px].
     """
-    g, _, _ = _gray(image)
+    g, quantum, _ = _gray(image)
     b = np.asarray(xywh, dtype=np.float64)
     if b.size == 0:
         return np.zeros((0, 2))
@@ -1479,6 +2336,13 @@ def waterline_points(image: ArrayLike, xywh: ArrayLike) -> FloatArray:
         thr = max(3.0 * sigma, 0.4 * float(np.percentile(diff, 95)))
         obj = diff > thr
         if not obj.any():
+            continue
+        raw = g[r0 : min(H, r1 + _WL_BELOW), c0:c1]
+        mask = np.zeros(raw.shape, dtype=bool)
+        mask[: obj.shape[0]] = obj
+        wl = _edge_waterline(raw, mask, quantum)
+        if wl is not None:
+            out[i] = (c0 + wl[0], r0 + wl[1])
             continue
         u, v = _waterline(obj)
         out[i] = (c0 - 0.5 + u, r0 - 0.5 + v)
