@@ -98,8 +98,8 @@ PIXEL_SIGMA = 1.0
 
 WORLD_SIGMA_A = 0.5
 """Process noise √q of the world EKF/UKF [m/s^1.5] (CWNA): real traffic turns and changes
-speed; on the demo clip 0.5 gives 19 % lower position RMSE than 0.1 (102.8 m against
-127.0 m)."""
+speed; on the demo clip 0.5 gave 19 % lower position RMSE than 0.1 (102.8 m against
+127.0 m, measured with the session-3 detector, before its water-line fix)."""
 
 MIN_TRUTH_PX = 5.0
 """Truth boxes less than this tall [px] (vessels far beyond a classical detector's reach)
