@@ -42,8 +42,8 @@ SMALL = {"width": 960, "height_px": 540, "fps": 5.0}
 # measured at 960×540, 5 frames/s (seed 0) — the reasons of the strict xfails below
 XFAIL: dict[tuple[str, str], str] = {
     ("range-1km", "range1km"): (
-        "issue 7 '5 % at 1 km' not met at 960x540: EKF range error 5.46 % RMS (bias "
-        "-3.91 %) in the 750-1250 m bin (met at 1080p/10 fps, docs/results/track/); at "
+        "issue 7 '5 % at 1 km' not met at 960x540: EKF range error 5.39 % RMS (bias "
+        "-3.73 %) in the 750-1250 m bin (met at 1080p/10 fps, docs/results/track/); at "
         "half the resolution one water-line pixel is twice the angle"
     ),
 }

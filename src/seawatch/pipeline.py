@@ -96,6 +96,13 @@ estimator (long form)."""
 PIXEL_SIGMA = 1.0
 """Default 1-σ of the water-line pixel [px] (detector jitter plus quantisation)."""
 
+COAST_SECONDS = 3.0
+"""How long a confirmed track survives without detections, by prediction [s] (at least
+the visual tracker's 12 frames): a ship does not vanish, it passes behind another one. On
+the demo clip (10 frames/s) the far vessel is hidden for ~2.5 s behind the large one; 3 s
+instead of 12 frames (1.2 s) keeps its id (ID switches 3 → 2, EKF position RMSE 49.9 →
+37.3 m, MOTA 0.868 → 0.836 from the coasted rows of the hidden vessel)."""
+
 WORLD_SIGMA_A = 0.5
 """Process noise √q of the world EKF/UKF [m/s^1.5] (CWNA): real traffic turns and changes
 speed; on the demo clip 0.5 gave 19 % lower position RMSE than 0.1 (102.8 m against
@@ -449,7 +456,8 @@ def track_video(
 
     reader = VideoReader(source, step=step, max_frames=max_frames)
     fps = reader.fps or 25.0
-    vtracker = VisualTracker(detector=detector, filter=filter, fps=fps)
+    coast = max(12, round(COAST_SECONDS * fps))
+    vtracker = VisualTracker(detector=detector, filter=filter, fps=fps, delete_after=coast)
     pose = _Pose(camera, platform, start, attitude, notes) if camera is not None else None
     world = None
     if camera is not None:

@@ -384,3 +384,22 @@ def test_non_increasing_times_raise_naming_time():
 def test_bad_parameters_raise_naming_the_parameter(kwargs, name):
     with pytest.raises(ValueError, match=name):
         MultiTargetTracker(**kwargs)
+
+
+def test_confirmed_first_keeps_a_detection_for_the_confirmed_track():
+    """Matching cascade: a detection between an established track (3 px away) and a
+    track born on it one scan before (on it) goes to the established one; without the
+    cascade the newborn, nearer and as tight, takes it (and is confirmed by it)."""
+    got = {}
+    for cascade in (False, True):
+        mtt = MultiTargetTracker(
+            sigma_z=2.0, sigma_v0=0.5, sigma_a=0.1, confirm_m=2, confirm_n=3,
+            confirmed_first=cascade,
+        )  # fmt: skip
+        for _ in range(5):
+            mtt.step(np.array([[0.0, 0.0]]))
+        mtt.step(np.array([[0.0, 0.0], [3.0, 0.0]]))  # a second track is born at x = 3
+        st = mtt.step(np.array([[3.0, 0.0]]))
+        got[cascade] = dict(zip(st.ids.tolist(), st.detection.tolist(), strict=True))
+    assert got[False] == {1: -1, 2: 0}
+    assert got[True] == {1: 0, 2: -1}

@@ -258,6 +258,14 @@ class MultiTargetTracker:
             of a ship whose box is re-segmented — a hull that gains its superstructure,
             a bow that becomes a whole ship at the image edge — where the centre jumps
             out of the gate. None (default): off.
+        confirmed_first: a matching cascade (as in DeepSORT, Wojke et al. 2017): the
+            confirmed tracks are assigned (gate, then overlap stage) before the
+            tentative ones, which get only the detections left over — a track born on
+            a fragment of a ship (a superstructure boxed alone for a frame) cannot take
+            the ship from its confirmed track; in the overlap stage the track with the
+            most detections is served first, so an established track, not one born a
+            few frames ago on a piece of its ship, takes a re-segmented box. False
+            (default): one assignment over all tracks, the most pairs first.
         filter_options: extra keyword arguments for a filter class (see above).
     """
 
@@ -276,6 +284,7 @@ class MultiTargetTracker:
         delete_after: int = 3,
         size_smoothing: float = 0.3,
         overlap_gate: float | None = None,
+        confirmed_first: bool = False,
         filter_options: dict[str, Any] | None = None,
     ) -> None:
         self.dt = positive("dt", dt)
@@ -300,6 +309,7 @@ class MultiTargetTracker:
             if overlap_gate is None
             else in_range("overlap_gate", overlap_gate, 0.0, 1.0, lo_open=True)
         )
+        self.confirmed_first = bool(confirmed_first)
         self.filter_options = dict(filter_options or {})
         self.H = position_measurement(_DIM, 2)
         self.R = self.sigma_z**2 * np.eye(_DIM)
@@ -433,7 +443,11 @@ class MultiTargetTracker:
         # 1. predict
         self._predict(dt)
         # 2.–3. gate and assign
-        rows, cols = self._associate(z)
+        boxes = sizes is not None and self.overlap_gate is not None
+        if self.confirmed_first:
+            rows, cols, r2, c2 = self._cascade(z, sizes[valid] if boxes else None)
+        else:
+            rows, cols = self._associate(z)
         # 4. update assigned tracks, misses for the others
         assigned = np.zeros(self.n_tracks, bool)
         assigned[rows] = True
@@ -444,8 +458,9 @@ class MultiTargetTracker:
         if sizes is not None and rows.size:
             s = self.size_smoothing
             self._size[rows] += s * (sizes[valid[cols]] - self._size[rows])
-        if sizes is not None and self.overlap_gate is not None:
-            r2, c2 = self._overlap_pairs(rows, cols, z, sizes[valid])
+        if boxes:
+            if not self.confirmed_first:
+                r2, c2 = self._overlap_pairs(rows, cols, z, sizes[valid])
             if r2.size:
                 restarted[r2] = True
                 self._restart(r2, z[c2], sizes[valid[c2]])
@@ -525,8 +540,36 @@ class MultiTargetTracker:
         S = self.H @ self._P @ self.H.T + self.R
         return 0.5 * (S + np.swapaxes(S, 1, 2))
 
-    def _associate(self, z: FloatArray) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-        """Mahalanobis gate and GNN assignment; returns (track rows, detection indices).
+    def _cascade(
+        self, z: FloatArray, sizes: FloatArray | None
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+        """The matching cascade (``confirmed_first``): the gate and the overlap stage for
+        the confirmed tracks, then both for the tentative tracks on the detections left.
+        Returns the gate's (rows, detections) and the overlap stage's."""
+        empty = np.empty(0, np.int64)
+        rows, cols, r2, c2 = [empty], [empty], [empty], [empty]
+        free = np.ones(z.shape[0], bool)
+        for group in (self._confirmed.copy(), ~self._confirmed):
+            r, c = self._associate(z, group, free)
+            free[c] = False
+            rows.append(r)
+            cols.append(c)
+            if sizes is not None:
+                taken = np.concatenate(rows + r2)
+                ro, co = self._overlap_pairs(taken, np.flatnonzero(~free), z, sizes, group)
+                free[co] = False
+                r2.append(ro)
+                c2.append(co)
+        return tuple(np.concatenate(a) for a in (rows, cols, r2, c2))  # type: ignore[return-value]
+
+    def _associate(
+        self,
+        z: FloatArray,
+        tracks: NDArray[np.bool_] | None = None,
+        dets: NDArray[np.bool_] | None = None,
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        """Mahalanobis gate and GNN assignment; returns (track rows, detection indices),
+        among the ``tracks`` and ``dets`` marked True (default: all).
 
         Candidate pairs come from a sort-and-sweep prefilter: ``d² <= gamma`` implies
         ``|y_x|, |y_y| <= sqrt(gamma · tr S)``, so only detections within that box of a
@@ -566,17 +609,29 @@ class MultiTargetTracker:
         ar, br, dr, detr = a[rows], b[rows], d[rows], det[rows]
         d2 = (dr * y[:, 0] ** 2 - 2.0 * br * y[:, 0] * y[:, 1] + ar * y[:, 1] ** 2) / detr
         gated = d2 <= self.gate
+        if tracks is not None:
+            gated &= tracks[rows]
+        if dets is not None:
+            gated &= dets[cols]
         rows, cols = rows[gated], cols[gated]
         return _assign_pairs(rows, cols, d2[gated] + np.log(detr[gated]))
 
     def _overlap_pairs(
-        self, rows: NDArray[np.int64], cols: NDArray[np.int64], z: FloatArray, sizes: FloatArray
+        self,
+        rows: NDArray[np.int64],
+        cols: NDArray[np.int64],
+        z: FloatArray,
+        sizes: FloatArray,
+        tracks: NDArray[np.bool_] | None = None,
     ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """Second stage (``overlap_gate``): unpaired tracks and detections whose boxes
         overlap by at least the gate (intersection over the smaller area), greedily by
-        overlap. Track boxes are the predicted centres with the smoothed sizes."""
+        overlap (with ``confirmed_first``, the track with the most detections first),
+        among the ``tracks`` marked True (default: all). Track boxes are the predicted
+        centres with the smoothed sizes."""
         empty = np.empty(0, np.int64)
-        free_t = np.setdiff1d(np.arange(self.n_tracks), rows)
+        pool = np.arange(self.n_tracks) if tracks is None else np.flatnonzero(tracks)
+        free_t = np.setdiff1d(pool, rows)
         free_d = np.setdiff1d(np.arange(z.shape[0]), cols)
         if free_t.size == 0 or free_d.size == 0:
             return empty, empty
@@ -588,8 +643,16 @@ class MultiTargetTracker:
         smaller = np.minimum(np.prod(ts, axis=1)[:, None], np.prod(ds, axis=1)[None])
         with np.errstate(invalid="ignore", divide="ignore"):
             ov = np.where(smaller > 0.0, inter / smaller, 0.0)
+        order = np.argsort(-ov, axis=None, kind="stable")
+        if self.confirmed_first:  # the track with the most detections first
+            hits = np.broadcast_to(self._hits[free_t][:, None], ov.shape).ravel()[order]
+            order = order[
+                np.argsort(
+                    -np.where(ov.ravel()[order] >= self.overlap_gate, hits, -1), kind="stable"
+                )
+            ]
         out_r, out_c = [], []
-        for flat in np.argsort(-ov, axis=None, kind="stable"):
+        for flat in order:
             i, j = divmod(int(flat), free_d.size)
             if ov[i, j] < self.overlap_gate:
                 break

@@ -100,6 +100,9 @@ class VisualTracker:
             tracking.mtt.MultiTargetTracker`): an unpaired track and detection whose boxes
             overlap by this fraction of the smaller box continue the same id (a ship
             entering at the image edge, a hull that gains its superstructure); None: off.
+        confirmed_first: the matching cascade of the tracker (confirmed tracks are
+            assigned before tentative ones): a track born on a fragment of a ship cannot
+            take the ship from its confirmed track.
         min_score: detections with a lower score are ignored.
         horizon: estimate the horizon per frame and give it to the detector (sea region).
         fps: frame rate used when frames come without times [1/s].
@@ -125,6 +128,7 @@ class VisualTracker:
         delete_after: int = 12,
         size_smoothing: float = 0.3,
         overlap_gate: float | None = 0.5,
+        confirmed_first: bool = True,
         min_score: float = 0.0,
         horizon: bool = True,
         fps: float = 25.0,
@@ -162,6 +166,7 @@ class VisualTracker:
             delete_after=delete_after,
             size_smoothing=size_smoothing,
             overlap_gate=overlap_gate,
+            confirmed_first=confirmed_first,
             filter_options=opts or None,
         )
         self._factory = factory
