@@ -47,6 +47,7 @@ import numpy as np
 from seawatch.camera.horizon import attitude_from_horizon
 from seawatch.camera.pinhole import PinholeCamera
 from seawatch.geometry.geodesy import north_east_to_geodetic
+from seawatch.io.prefetch import prefetch
 from seawatch.io.track_table import TableWriter
 from seawatch.io.video import VideoReader
 from seawatch.tracking.world import ESTIMATORS, PlatformPose, WorldEstimates, WorldTracker
@@ -501,9 +502,12 @@ def track_video(
     labels: dict[int, int | None] = {}
     live_ids: set[int] = set()
     interrupted = False
+    # decode and horizon of the next frames run ahead in a thread (:mod:`seawatch.io.
+    # prefetch`) while this one is detected, tracked and written
+    frames_ahead = prefetch(reader, work=lambda f: (f, vtracker.horizon(f.image, f.time)))
     try:
-        for frame in reader:
-            rows = vtracker.step(frame.image, frame.time)
+        for frame, hz in frames_ahead:
+            rows = vtracker.update(vtracker.detect(frame.image, frame.time, horizon=hz))
             horizon = vtracker.last_horizon
             t = float(frame.time)
             k = rows.shape[0]
@@ -599,6 +603,7 @@ def track_video(
         interrupted = True
         note(f"interrupted after {frames} frames; outputs hold every frame done")
     finally:
+        frames_ahead.close()  # type: ignore[attr-defined]
         outputs = tracks_out.close()
         if est_out is not None:
             outputs += est_out.close()

@@ -46,8 +46,11 @@ from seawatch.vision.detect import ClassicalShipDetector, Detections
 __all__ = ["FILTERS", "TRACK_COLUMNS", "VisualTracker", "tracks_to_rows"]
 
 TRACK_COLUMNS: tuple[str, ...] = ("id", "x", "y", "w", "h", "u_wl", "v_wl", "misses")
+
 """Columns of a per-frame track array: track id, box top-left x, y [px], width w and
 height h [px], water-line point u_wl, v_wl [px], consecutive missed detections [frames]."""
+
+_FIND = object()  # detect(): find the horizon of the frame
 
 FilterName = Literal["afkf", "fkf", "kf"]
 FILTERS: tuple[str, ...] = ("afkf", "fkf", "kf")
@@ -192,11 +195,20 @@ class VisualTracker:
             reset()
 
     # ------------------------------------------------------------------ per frame
-    def detect(self, image: ArrayLike, time: float | None = None) -> FloatArray:
-        """Detections (k, 7) ``x, y, w, h, score, u_wl, v_wl`` of one frame (step 1)."""
-        hz = None
-        if self._horizon is not None:
-            hz = self._horizon.update(image, time)
+    def horizon(self, image: ArrayLike, time: float | None = None) -> Any:
+        """The horizon of the next frame (the smoothed :class:`~seawatch.vision.horizon.
+        HorizonEstimate`; None with the horizon off). Call it once per frame, in frame
+        order, and hand the result to :meth:`detect` — it may run ahead in another thread
+        (the track job finds a frame's horizon while the previous frame is detected)."""
+        return self._horizon.update(image, time) if self._horizon is not None else None
+
+    def detect(
+        self, image: ArrayLike, time: float | None = None, *, horizon: Any = _FIND
+    ) -> FloatArray:
+        """Detections (k, 7) ``x, y, w, h, score, u_wl, v_wl`` of one frame (step 1);
+        ``horizon``: the frame's :meth:`horizon` when found already (default: found
+        here)."""
+        hz = self.horizon(image, time) if horizon is _FIND else horizon
         self.last_horizon = hz
         try:
             det = self.detector(image, horizon=hz)

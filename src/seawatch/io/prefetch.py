@@ -1,0 +1,92 @@
+"""Read ahead: the items of an iterator produced in a background thread.
+
+The track job decodes a frame and finds its horizon while the previous frame's ships are
+detected and tracked: PyAV's decoder and most of OpenCV's and numpy's work release the
+GIL, so on two cores the stages overlap. Written here because the standard library has
+no bounded read-ahead iterator with error propagation and early-exit clean-up
+(``concurrent.futures`` maps whole sequences; ``queue.Queue`` is the building block).
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+import time
+from collections.abc import Callable, Iterable, Iterator
+from typing import Any, TypeVar
+
+T = TypeVar("T")
+
+_ITEM, _ERROR, _END = 0, 1, 2
+
+
+def prefetch(
+    items: Iterable[Any], depth: int = 3, work: Callable[[Any], T] | None = None
+) -> Iterator[T]:
+    """Iterate ``items`` (each passed through ``work`` when given) in a background
+    thread, at most ``depth`` items ahead of the consumer, in order.
+
+    An exception raised by ``items`` or ``work`` is raised by the returned iterator at
+    that item, after the items before it. When the consumer stops early (``break``, an
+    exception, Ctrl-C), the thread stops at its next item and the source iterator is
+    closed in that thread.
+
+    Args:
+        items: any iterable (e.g. a :class:`~seawatch.io.video.VideoReader`).
+        depth: how many items may wait (>= 1).
+        work: optional per-item function run in the background thread.
+
+    Raises:
+        ValueError: ``depth`` < 1.
+    """
+    if isinstance(depth, bool) or not isinstance(depth, int) or depth < 1:
+        raise ValueError(f"depth: expected an integer >= 1, got {depth!r}")
+    q: queue.Queue[tuple[int, Any]] = queue.Queue(maxsize=depth)
+    stop = threading.Event()
+
+    def put(kind: int, value: Any) -> bool:
+        while not stop.is_set():
+            try:
+                q.put((kind, value), timeout=0.1)
+                return True
+            except queue.Full:
+                continue
+        return False
+
+    def produce() -> None:
+        it = iter(items)
+        try:
+            for x in it:
+                if stop.is_set() or not put(_ITEM, work(x) if work is not None else x):
+                    return
+        except BaseException as exc:  # handed to the consumer, raised there
+            put(_ERROR, exc)
+            return
+        finally:
+            close = getattr(it, "close", None)
+            if callable(close):
+                close()
+        put(_END, None)
+
+    thread = threading.Thread(target=produce, name="seawatch-prefetch", daemon=True)
+    thread.start()
+
+    def consume() -> Iterator[T]:
+        try:
+            while True:
+                kind, value = q.get()
+                if kind == _END:
+                    return
+                if kind == _ERROR:
+                    raise value
+                yield value
+        finally:
+            stop.set()
+            deadline = time.monotonic() + 2.0  # a live source may block in its read
+            while thread.is_alive() and time.monotonic() < deadline:
+                try:
+                    q.get(timeout=0.05)  # unblock a producer waiting to put
+                except queue.Empty:
+                    pass
+
+    return consume()
