@@ -1518,6 +1518,9 @@ class ClassicalShipDetector:
                 uu, vv = _waterline(ship)
                 u, v = x + uu, y + vv
             w, h = float(sc1 - sc0 + 1), float(sr1 - sr0 + 1)
+            # the box holds its water line: a sub-pixel edge may lie in the row below the
+            # last half-covered one
+            h = max(h, float(v) - y)
             out.append((x, y, w, h, u, v, float(np.count_nonzero(ship))))
         return out
 
