@@ -1571,17 +1571,8 @@ class ClassicalShipDetector:
         res /= cv2.remap(lv.sigma, mx, my, **remap)  # in noise units, like z
         chroma = False
         if lv.chroma and fr.colour is not None:
-            col = np.ascontiguousarray(fr.colour[gy0:gy1, gx0:gx1])
-            ycc = cv2.cvtColor(col, cv2.COLOR_BGR2YCrCb).astype(np.float32)
-            ycc = cv2.GaussianBlur(ycc, (3, 3), 0.8, borderType=cv2.BORDER_REPLICATE)[inner]
-            cx, cy = (mx + 0.5) / 2 - 0.5, (my + 0.5) / 2 - 0.5  # half-resolution planes
             luma = res.copy()
-            for ch_index, hc, lc, sc in lv.chroma:
-                gc = ycc[:, :, ch_index]
-                hi_c = cv2.remap(hc, cx, cy, **remap)
-                lo_c = cv2.remap(lc, cx, cy, **remap)
-                rc = np.maximum(gc - hi_c, lo_c - gc) / cv2.remap(sc, cx, cy, **remap)
-                np.maximum(res, rc, out=res)
+            np.maximum(res, _chroma_contrast(fr, lv, (gx0, gy0, gx1, gy1), inner, mx, my), out=res)
             chroma = bool(np.any(res > luma + 1e-6))
         # the candidate's own pixels (no margin)
         cx0 = max(0, math.floor(bx0 * sx) - fx0)
@@ -1780,20 +1771,36 @@ class ClassicalShipDetector:
         gx0, gy0 = max(0, X0 - 1), max(0, Y0 - 1)
         gx1, gy1 = min(W, X1 + 1), min(H, Y1 + 1)
         inner = (slice(Y0 - gy0, Y1 - gy0), slice(X0 - gx0, X1 - gx0))
-        assert fr.colour is not None and lv.chroma is not None
-        col = np.ascontiguousarray(fr.colour[gy0:gy1, gx0:gx1])
-        ycc = cv2.cvtColor(col, cv2.COLOR_BGR2YCrCb).astype(np.float32)
-        ycc = cv2.GaussianBlur(ycc, (3, 3), 0.8, borderType=cv2.BORDER_REPLICATE)[inner]
-        cx, cy = (mx + 0.5) / 2 - 0.5, (my + 0.5) / 2 - 0.5  # half-resolution planes
-        remap = {"interpolation": cv2.INTER_LINEAR, "borderMode": cv2.BORDER_REPLICATE}
-        out = np.zeros(mx.shape, np.float32)
-        for ch_index, hc, lc, sc in lv.chroma:
-            gc = ycc[:, :, ch_index]
-            hi_c = cv2.remap(hc, cx, cy, **remap)
-            lo_c = cv2.remap(lc, cx, cy, **remap)
-            rc = np.maximum(gc - hi_c, lo_c - gc) / cv2.remap(sc, cx, cy, **remap)
-            np.maximum(out, rc, out=out)
-        return out
+        return np.maximum(_chroma_contrast(fr, lv, (gx0, gy0, gx1, gy1), inner, mx, my), 0.0)
+
+
+def _chroma_contrast(
+    fr: _Frame,
+    lv: _Level,
+    crop: tuple[int, int, int, int],
+    inner: tuple[slice, slice],
+    mx: NDArray,
+    my: NDArray,
+) -> NDArray:
+    """The largest noise-normalised CFAR contrast of the chroma planes (Cr, Cb; class
+    docstring, step 3) at full-resolution pixels: the frame's colour ``crop`` (x0, y0,
+    x1, y1, one pixel of context for the smoothing) cut to ``inner``, against the finest
+    level's chroma backgrounds and noise sampled at its working coordinates (mx, my)."""
+    assert fr.colour is not None and lv.chroma is not None
+    x0, y0, x1, y1 = crop
+    col = np.ascontiguousarray(fr.colour[y0:y1, x0:x1])
+    ycc = cv2.cvtColor(col, cv2.COLOR_BGR2YCrCb).astype(np.float32)
+    ycc = cv2.GaussianBlur(ycc, (3, 3), 0.8, borderType=cv2.BORDER_REPLICATE)[inner]
+    cx, cy = (mx + 0.5) / 2 - 0.5, (my + 0.5) / 2 - 0.5  # half-resolution planes
+    remap = {"interpolation": cv2.INTER_LINEAR, "borderMode": cv2.BORDER_REPLICATE}
+    out = np.full(mx.shape, -np.inf, np.float32)
+    for ch_index, hc, lc, sc in lv.chroma:
+        gc = ycc[:, :, ch_index]
+        hi_c = cv2.remap(hc, cx, cy, **remap)
+        lo_c = cv2.remap(lc, cx, cy, **remap)
+        rc = np.maximum(gc - hi_c, lo_c - gc) / cv2.remap(sc, cx, cy, **remap)
+        np.maximum(out, rc, out=out)
+    return out
 
 
 def _median3(a: NDArray, b: NDArray, c: NDArray) -> NDArray:
