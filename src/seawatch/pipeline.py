@@ -99,7 +99,7 @@ PIXEL_SIGMA = 1.0
 
 COAST_SECONDS = 3.0
 """How long a confirmed track survives without detections, by prediction [s] (at least
-the visual tracker's 12 frames): a ship does not vanish, it passes behind another one.
+:data:`REPORT_COAST_FRAMES`): a ship does not vanish, it passes behind another one.
 On the demo clip (10 frames/s) 3 s instead of 12 frames (1.2 s) keeps the far vessel's
 id behind the large one for longer (ID switches 3 → 2, EKF position RMSE 49.9 → 37.3 m)."""
 
@@ -463,7 +463,7 @@ def track_video(
 
     reader = VideoReader(source, step=step, max_frames=max_frames)
     fps = reader.fps or 25.0
-    coast = max(12, round(COAST_SECONDS * fps))
+    coast = max(REPORT_COAST_FRAMES, round(COAST_SECONDS * fps))
     vtracker = VisualTracker(detector=detector, filter=filter, fps=fps, delete_after=coast)
     pose = _Pose(camera, platform, start, attitude, notes) if camera is not None else None
     world = None

@@ -644,13 +644,9 @@ class MultiTargetTracker:
         with np.errstate(invalid="ignore", divide="ignore"):
             ov = np.where(smaller > 0.0, inter / smaller, 0.0)
         order = np.argsort(-ov, axis=None, kind="stable")
-        if self.confirmed_first:  # the track with the most detections first
-            hits = np.broadcast_to(self._hits[free_t][:, None], ov.shape).ravel()[order]
-            order = order[
-                np.argsort(
-                    -np.where(ov.ravel()[order] >= self.overlap_gate, hits, -1), kind="stable"
-                )
-            ]
+        if self.confirmed_first:  # pairs in the gate: most detections first, then overlap
+            hits = np.where(ov >= self.overlap_gate, self._hits[free_t][:, None], -1)
+            order = np.lexsort((-ov.ravel(), -hits.ravel()))
         out_r, out_c = [], []
         for flat in order:
             i, j = divmod(int(flat), free_d.size)

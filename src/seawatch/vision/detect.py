@@ -2066,8 +2066,7 @@ def _theil_sen(x: NDArray, y: NDArray, u: float) -> tuple[float, float, float]:
     ok = dx != 0
     slope = float(np.median((y[sub][j] - y[sub][i])[ok] / dx[ok])) if ok.any() else 0.0
     r = y - slope * (x - u)
-    v = float(np.median(r))
-    return v, slope, 1.4826 * float(np.median(np.abs(r - v)))
+    return float(np.median(r)), slope, _mad(r)
 
 
 def _theil_sen_at(x: NDArray, y: NDArray, u: float) -> float:
@@ -2163,7 +2162,7 @@ def _waterline_levels(
     em = e.copy()
     em[1:-1] = _median3(e[:-2], e[1:-1], e[2:])
     d = np.diff(e)
-    noise = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(2.0)
+    noise = _mad(d) / math.sqrt(2.0)
     J = max(jump, 4.0 * noise)
     # between columns i and i + 1: the medians of the three edges after and before
     ext = np.r_[em[0], em[0], em, em[-1], em[-1]]

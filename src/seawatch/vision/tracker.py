@@ -46,7 +46,6 @@ from seawatch.vision.detect import ClassicalShipDetector, Detections
 __all__ = ["FILTERS", "TRACK_COLUMNS", "VisualTracker", "tracks_to_rows"]
 
 TRACK_COLUMNS: tuple[str, ...] = ("id", "x", "y", "w", "h", "u_wl", "v_wl", "misses")
-
 """Columns of a per-frame track array: track id, box top-left x, y [px], width w and
 height h [px], water-line point u_wl, v_wl [px], consecutive missed detections [frames]."""
 
