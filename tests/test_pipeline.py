@@ -74,3 +74,13 @@ def test_unwritable_output_folder_fails_before_any_work(clip, tmp_path):
     blocker.write_text("not a folder")
     with pytest.raises(ValueError, match="cannot write"):
         track_video(clip / "video.mp4", blocker / "out")
+
+
+def test_error_summary_counts_identity_switches_in_words():
+    from seawatch.pipeline import error_summary
+
+    base = {"rmse_position_m": 37.3, "rmse_range_percent": 2.62, "mota": 0.873, "idf1": 0.883}
+    one = error_summary({**base, "id_switches": 1})
+    assert one[1] == "MOTA 0.873, IDF1 0.883, 1 identity switch"
+    assert error_summary({**base, "id_switches": 3})[1].endswith("3 identity switches")
+    assert error_summary({**base, "id_switches": 0})[1].endswith("0 identity switches")

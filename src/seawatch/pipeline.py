@@ -654,10 +654,11 @@ def error_summary(errors: Mapping[str, Any] | None) -> list[str]:
     if not errors:
         return []
     e = errors
+    n = e.get("id_switches", 0)
     return [
         f"position RMSE {e.get('rmse_position_m', float('nan')):.1f} m, range error "
         f"{e.get('rmse_range_percent', float('nan')):.2f} %",
         f"MOTA {e.get('mota', float('nan')):.3f}, IDF1 {e.get('idf1', float('nan')):.3f}, "
-        f"{e.get('id_switches', 0)} identity switches",
+        f"{n} identity switch{'' if n == 1 else 'es'}",
         f"box centre error {e.get('cle_px', float('nan')):.1f} px",
     ]
