@@ -337,10 +337,22 @@ def test_no_horizon_in_view_is_not_found_with_low_confidence(name: str):
 def test_real_boat_camera_images_against_imu_horizon_masks():
     """Per-image mean column error [px] of the six WaSR examples (512 × 384).
 
-    Open sea / distant coast (02 fog, 03 coastline, 06 open sea): below 1 % of the
-    height. Harbours (01, 04): the IMU horizon lies at the top of the near piers, the
-    water edge that the detector finds a few pixels lower: below 3 %. 05 is a Venice
-    canal without any sea horizon in view: not found.
+    Measured (issue 6): 01 9.8, 02 1.9, 03 2.4, 04 5.4, 06 2.5 px; mean over the five
+    with a sea horizon 4.39 px = 1.14 % of the height (the issue's target, < 1 %, is
+    not met). The bounds below are those numbers with a margin, as a regression guard.
+
+    Open sea / distant coast (02 fog, 03 coastline, 06 open sea): the line is on the
+    visible sky/sea or shore/sea edge; what remains is mostly the masks' own error:
+    in 03 the visible water reaches rows 216–221 at the right border (columns
+    470–511, the luma step of the distant shore's water line at row 214.5) where the
+    IMU horizon is at 221.5, i.e. sea above the horizon, which cannot be; in the
+    middle (columns 180–299) the water line is at 221.5, the IMU horizon at 223.5.
+    Harbours (01, 04): the sea horizon itself is hidden behind the near piers and
+    hulls; the IMU horizon runs through that band (~20 px between the water line
+    and the distant skyline), near the top of the low structures. The detector finds
+    the water edge at the base of the band in 01 (10 px low) and the band's upper
+    edge at the right in 04 (up to 12 px high). 05 is a Venice canal without any sea
+    horizon in view: not found.
     """
     errors = {}
     for image in sorted((DATA / "images").glob("*.jpg")):
@@ -349,12 +361,20 @@ def test_real_boat_camera_images_against_imu_horizon_masks():
         est = detect_horizon(img)
         errors[image.stem] = (column_error(est, truth), est.found)
     h = 384
+    bounds = {  # [px] measured + margin
+        "example_01": 11.0,
+        "example_02": 2.5,
+        "example_03": 3.0,
+        "example_04": 6.0,
+        "example_06": 3.0,
+    }
+    for name, bound in bounds.items():
+        err, found = errors[name]
+        assert found and err < bound, (name, err)
     for name in ("example_02", "example_03", "example_06"):
-        err, found = errors[name]
-        assert found and err < 0.01 * h, (name, err)
-    for name in ("example_01", "example_04"):
-        err, found = errors[name]
-        assert found and err < 0.03 * h, (name, err)
+        assert errors[name][0] < 0.01 * h, (name, errors[name][0])
+    mean = float(np.mean([errors[name][0] for name in bounds]))
+    assert mean < 0.012 * h, mean  # measured 1.14 %
     assert not errors["example_05"][1]
 
 
