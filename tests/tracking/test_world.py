@@ -268,7 +268,12 @@ def test_ekf_and_ukf_equal_the_library_filters_step_by_step_with_missed_frames(
             last[i] = t[k]
 
 
-def test_diffuse_rls_estimator_equals_public_diffuse_rls_with_a_missed_frame_and_a_restart():
+@pytest.mark.parametrize("missing_as", ["absent", "nan"])
+def test_diffuse_rls_estimator_equals_public_diffuse_rls_with_a_missed_frame_and_a_restart(
+    missing_as,
+):
+    """Missed frames as an absent id or as NaN angles (the track job's coasting rows):
+    the same missing samples, and the same restart after the 3.2-s gap."""
     rng = np.random.default_rng(3)
     T = 400
     t = np.arange(T) / FPS
@@ -286,23 +291,29 @@ def test_diffuse_rls_estimator_equals_public_diffuse_rls_with_a_missed_frame_and
     last = None
     n_ar = 0
     for k in range(T):
-        if not present[k]:
-            trk.update(t[k], np.zeros(0, dtype=int), [], [])  # frames go on without it
+        if not present[k] and missing_as == "absent":  # frames go on without it
+            trk.update(t[k], np.zeros(0, dtype=int), [], [])
             continue
-        e = trk.update(t[k], [7], [az[k]], [dep[k]])["diffuse-rls"]
-        if last is not None:
-            gap = t[k] - last
-            if gap > 2.0:
-                ra.reset()
-                rb.reset()
-            else:
-                for _ in range(round(gap * FPS) - 1):
-                    ra.update(np.nan)
-                    rb.update(np.nan)
-        last = t[k]
-        fa, fb = ra.update(az[k]), rb.update(dep[k])
+        if not present[k]:  # a predict-only step of both AR models, now
+            e = trk.update(t[k], [7], [np.nan], [np.nan])["diffuse-rls"]
+            fa, fb = ra.update(np.nan), rb.update(np.nan)
+        else:
+            e = trk.update(t[k], [7], [az[k]], [dep[k]])["diffuse-rls"]
+            if last is not None:
+                gap = t[k] - last  # since the last measurement
+                if gap > 2.0:
+                    ra.reset()
+                    rb.reset()
+                elif missing_as == "absent":
+                    for _ in range(round(gap * FPS) - 1):
+                        ra.update(np.nan)
+                        rb.update(np.nan)
+            last = t[k]
+            fa, fb = ra.update(az[k]), rb.update(dep[k])
         pos = sea_position((0.0, 0.0), 0.0, fa, fb, HEIGHT, curved=True).xy
         np.testing.assert_allclose(e.position[0], pos, rtol=1e-9)
+        if not np.all(np.isfinite(pos)):
+            continue
         hist_t.append(t[k])
         hist_p.append(pos)
         tw = np.array(hist_t)
@@ -319,6 +330,89 @@ def test_diffuse_rls_estimator_equals_public_diffuse_rls_with_a_missed_frame_and
                     fpos = sea_position((0.0, 0.0), 0.0, a[j - 1], b[j - 1], HEIGHT, curved=True)
                     np.testing.assert_allclose(e.forecasts[tau][0], fpos.xy[()], rtol=1e-8)
     assert n_ar > 100  # the AR forecast path was exercised
+
+
+@pytest.mark.parametrize("robust_gate", [0.99, 0.9])
+def test_robust_ekf_update_is_the_ekf_update_with_the_inflated_noise(robust_gate):
+    """``robust_gate``: each update equals ``ExtendedKalmanFilter.update`` with
+    ``R' = R + (ν/g − 1) S`` when the NIS ν exceeds the χ² gate g(p, 2 dof), else with
+    R; Gaussian noise plus every 10th depression off by 8 σ (a merged box)."""
+    rng = np.random.default_rng(12)
+    T = 120
+    t = np.arange(T) / FPS
+    truth = np.array([[1400.0, 300.0]]) + t[:, None] * np.array([-3.0, 5.0])
+    az, dep = _angles(truth[:, None], np.zeros((T, 2)))
+    az = az[:, 0] + SIGMA * rng.standard_normal(T)
+    dep = dep[:, 0] + SIGMA * rng.standard_normal(T)
+    dep[10::10] += 8.0 * SIGMA
+    sigma_a = 0.3
+    trk = WorldTracker(
+        HEIGHT, sigma_angle=SIGMA, sigma_a=sigma_a, estimators=("ekf",), robust_gate=robust_gate
+    )
+    g = chi2.ppf(robust_gate, 2)
+    model = SeaSurfaceAngles(HEIGHT, observer=(0.0, 0.0), curved=True)
+    R = SIGMA**2 * np.eye(2)
+    ref = None
+    inflated = 0
+    for k in range(T):
+        e = trk.update(t[k], [3], [az[k]], [dep[k]])["ekf"]
+        if ref is None:
+            fix = sea_position((0.0, 0.0), 0.0, az[0], dep[0], HEIGHT, curved=True)
+            P0 = np.zeros((4, 4))
+            P0[:2, :2] = sea_position_covariance(
+                0.0, az[0], dep[0], HEIGHT, SIGMA, SIGMA, curved=True
+            )
+            P0[2, 2] = P0[3, 3] = 100.0
+            F1, Q1 = constant_velocity(2, 1.0 / FPS, sigma_a, noise="continuous")
+            ref = ExtendedKalmanFilter(F1, Q1, model, R, np.r_[fix.xy, 0.0, 0.0], P0)
+            continue
+        ref.predict()
+        H = model.jacobian(ref.x)
+        S = H @ ref.P @ H.T + R
+        y = np.array([az[k], dep[k]]) - model(ref.x)
+        y[0] = (y[0] + np.pi) % (2 * np.pi) - np.pi
+        nis = float(y @ np.linalg.solve(S, y))
+        Rk = R + (nis / g - 1.0) * S if nis > g else R
+        inflated += nis > g
+        ref.update([az[k], dep[k]], R=Rk)
+        np.testing.assert_allclose(e.position[0], ref.x[:2], rtol=1e-9)
+        np.testing.assert_allclose(e.covariance[0], ref.P[:2, :2], rtol=1e-7)
+        np.testing.assert_allclose(e.nis[0], nis, rtol=1e-7)  # the raw NIS is reported
+    assert inflated >= 10  # the outliers (and, at p = 0.9, some Gaussian tails) were gated
+
+
+@pytest.mark.parametrize("name", ["ekf", "ukf"])
+def test_robust_update_all_but_ignores_a_gross_water_line_error(name):
+    """A converged track gets one depression 20 σ off (two ships merged in one box): the
+    plain filter's range jumps by tens of metres, the robust one's by under a tenth of
+    that."""
+    rng = np.random.default_rng(13)
+    T = 200
+    t = np.arange(T) / FPS
+    truth = np.array([[1500.0, -200.0]]) + t[:, None] * np.array([2.0, 4.0])
+    az, dep = _angles(truth[:, None], np.zeros((T, 2)))
+    az = az[:, 0] + SIGMA * rng.standard_normal(T)
+    dep = dep[:, 0] + SIGMA * rng.standard_normal(T)
+    bad = dep.copy()
+    bad[-1] += 20.0 * SIGMA
+    jumps = {}
+    for gate in (None, 0.99):
+        out = []
+        for series in (dep, bad):
+            trk = WorldTracker(
+                HEIGHT,
+                sigma_angle=SIGMA,
+                sigma_a=1.0,
+                estimators=(name,),
+                best=name,
+                robust_gate=gate,
+            )
+            for k in range(T):
+                e = trk.update(t[k], [1], [az[k]], [series[k]])[name]
+            out.append(e.range[0])
+        jumps[gate] = abs(out[1] - out[0])
+    assert jumps[None] > 20.0  # measured 46.8 m (EKF)
+    assert jumps[0.99] < 0.1 * jumps[None]  # measured 2.6 m: scaled by g/ν
 
 
 # ------------------------------------------------------------------------------ accuracy
@@ -591,6 +685,9 @@ def test_outputs_follow_the_given_id_order_and_drop_restarts_an_id():
         ({"frame_interval": 0.0}, "frame_interval"),
         ({"max_gap": -1.0}, "max_gap"),
         ({"earth_radius": 0.0}, "earth_radius"),
+        ({"robust_gate": 1.0}, "robust_gate"),
+        ({"robust_gate": 0.0}, "robust_gate"),
+        ({"robust_gate": float("nan")}, "robust_gate"),
     ],
 )
 def test_bad_configuration_raises_value_error_naming_the_argument(kwargs, name):

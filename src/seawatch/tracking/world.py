@@ -84,6 +84,16 @@ a measurement at least ``init_margin`` σ_β below the horizon (and at a point-w
 whose measured depression is at or above the dip is used as an **azimuth-only** update
 (the exact scalar EKF/UKF update with the azimuth row); any other frame is a full update.
 
+Robust update (``robust_gate``, off by default): detectors make gross errors a Gaussian
+model does not foresee — two ships merged into one box, a box on the superstructure —
+and one such water line moves a range by tens of percent. With a gate probability p,
+an EKF/UKF innovation whose NIS ν exceeds the χ² quantile g(p) (1 degree of freedom for
+an azimuth-only update, 2 otherwise) is used with the measurement noise inflated to
+``R + (ν/g − 1) S`` (so ``S' = (ν/g) S``): its correction is scaled by g/ν, a gross
+error is all but ignored, and the covariance update stays the exact one for the
+inflated noise (the state's σ still grows by the process noise, so a real manoeuvre
+is followed once the prediction's uncertainty covers it). The NIS reported is the raw ν.
+
 Missing measurements: a track id absent from a frame is not touched (its next update
 predicts over the longer interval). NaN in either angle of a listed track is a
 predict-only step for the EKF/UKF (its outputs are the prediction), a missing sample
@@ -94,7 +104,12 @@ interval T (``frame_interval``, or else the shortest interval seen between two
 ``update`` calls). A track updated after ``dt`` gets ``round(dt / T) − 1`` missing
 samples (NaN: the RLS's predict-only step, see ``DiffuseRLS.update``) before the new
 one; a gap longer than ``max_gap`` seconds restarts both AR models from the diffuse start
-instead. Forecast steps: ``round(τ / T)`` AR steps for a horizon τ [s].
+instead. Missing samples count as a gap too: the first measurement after more than
+``max_gap`` seconds of NaN angles restarts the AR models (a track that coasts through an
+occlusion would otherwise carry a long run of AR predictions — from a model that may
+have seen only a few samples — in its regressors for ever: on the demo clip the large
+vessel's diffuse-RLS positions were NaN for 244 of its 283 frames after a 2.7-s
+occlusion). Forecast steps: ``round(τ / T)`` AR steps for a horizon τ [s].
 
 Units: SI and radians throughout; the tangent plane is that of the camera's reference
 point (x North, y East), on which distances are read as arc distances along the sea
@@ -141,6 +156,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
+from scipy.stats import chi2
 
 from seawatch._validation import FloatArray, as_float_array, covariance, in_range, positive
 from seawatch.filters.diffuse_rls import DiffuseRLS, DiffuseRLSBank
@@ -487,10 +503,17 @@ def _correct(
     R: FloatArray,
     K: FloatArray,
     A: FloatArray,
+    gate: float,
 ) -> float:
     """``K = C S⁻¹``, ``x += K y`` and the covariance update: Joseph form ``A P Aᵀ + K R Kᵀ``
-    (A = I − K H, EKF) or ``P − K S Kᵀ`` (UKF); returns NIS ``yᵀ S⁻¹ y``, NaN (state
-    unchanged) if S is not positive definite."""
+    (A = I − K H, EKF) or ``P − K S Kᵀ`` (UKF); returns NIS ``ν = yᵀ S⁻¹ y``, NaN (state
+    unchanged) if S is not positive definite.
+
+    Robust update (``gate`` finite; module docstring): an innovation with ``ν > gate``
+    is used with the measurement noise inflated to ``R' = R + (α − 1) S``, ``α = ν /
+    gate``, so that ``S' = α S`` (the update's own NIS equals the gate) and the
+    correction is scaled by 1/α. R and S are modified in place; the NIS returned is the
+    raw ``ν``."""
     s01 = 0.5 * (S[0, 1] + S[1, 0])
     det = S[0, 0] * S[1, 1] - s01 * s01
     if not (S[0, 0] > 0.0 and det > 0.0):
@@ -498,6 +521,16 @@ def _correct(
     i00 = S[1, 1] / det
     i11 = S[0, 0] / det
     i01 = -s01 / det
+    nis = y[0] * (i00 * y[0] + i01 * y[1]) + y[1] * (i01 * y[0] + i11 * y[1])
+    if nis > gate:
+        alpha = nis / gate
+        for a in range(2):
+            for b in range(2):
+                R[a, b] += (alpha - 1.0) * S[a, b]
+                S[a, b] *= alpha
+        i00 /= alpha
+        i11 /= alpha
+        i01 /= alpha
     for i in range(4):
         K[i, 0] = C[i, 0] * i00 + C[i, 1] * i01
         K[i, 1] = C[i, 0] * i01 + C[i, 1] * i11
@@ -533,7 +566,7 @@ def _correct(
             v = 0.5 * (P[i, j] + P[j, i])
             P[i, j] = v
             P[j, i] = v
-    return y[0] * (i00 * y[0] + i01 * y[1]) + y[1] * (i01 * y[0] + i11 * y[1])
+    return nis
 
 
 @njit(cache=True)
@@ -553,6 +586,8 @@ def _ekf_bank(
     curved: bool,
     dip: float,
     nis: FloatArray,
+    gate1: float,
+    gate2: float,
 ) -> int:
     """Predict over dt[i], then EKF-update (``ExtendedKalmanFilter``: y = wrap(z − h(x⁻)),
     S = H P Hᵀ + R, Joseph form) each listed track's slot in place. NaN z: predict only.
@@ -586,7 +621,7 @@ def _ekf_bank(
         for a in range(2):
             for b in range(2):
                 S[a, b] = R[a, b] + H[a, 0] * C[0, b] + H[a, 1] * C[1, b]
-        v = _correct(x, Pi, C, S, y, True, H, R, K, A)
+        v = _correct(x, Pi, C, S, y, True, H, R, K, A, gate1 if az_only else gate2)
         if not math.isfinite(v):
             return i
         nis[i] = v
@@ -610,6 +645,8 @@ def _ukf_bank(
     curved: bool,
     dip: float,
     nis: FloatArray,
+    gate1: float,
+    gate2: float,
 ) -> int:
     """Predict over dt[i], then UKF-update (``UnscentedKalmanFilter`` with α = 1, β = 2,
     κ = 0 for n = 4: χ = x, x ± columns of chol(4 P⁻); weights Wᵐ = (0, 1/8, …),
@@ -686,7 +723,7 @@ def _ukf_bank(
                 S[a, b] += R[a, b]
         y[0] = _wrap(z[i, 0] - zh[0])
         y[1] = 0.0 if az_only else _wrap(z[i, 1] - zh[1])
-        v = _correct(x, Pi, C, S, y, False, H, R, K, A)
+        v = _correct(x, Pi, C, S, y, False, H, R, K, A, gate1 if az_only else gate2)
         if not math.isfinite(v):
             return i
         nis[i] = v
@@ -829,6 +866,10 @@ class WorldTracker:
         max_gap: longest gap [s] bridged by missing samples in the diffuse RLS; a longer
             one restarts its AR models.
         earth_radius: earth radius R [m].
+        robust_gate: EKF/UKF robust update: the probability p in (0, 1) of the χ² gate
+            (1 degree of freedom for an azimuth-only update, 2 for a full one) above
+            which an innovation is down-weighted (``_correct``; module docstring,
+            "Robust update"); None: the plain update.
 
     Raises:
         ValueError: naming the argument, for any bad configuration.
@@ -855,6 +896,7 @@ class WorldTracker:
         frame_interval: float | None = None,
         max_gap: float = 2.0,
         earth_radius: float = EARTH_RADIUS,
+        robust_gate: float | None = None,
     ) -> None:
         self.height = positive("height", height)
         self.sigma_angle = positive("sigma_angle", sigma_angle)
@@ -897,6 +939,16 @@ class WorldTracker:
             None if frame_interval is None else positive("frame_interval", frame_interval)
         )
         self.max_gap = positive("max_gap", max_gap)
+        self.robust_gate = (
+            None
+            if robust_gate is None
+            else in_range("robust_gate", robust_gate, 0.0, 1.0, lo_open=True, hi_open=True)
+        )
+        self._gate = (
+            (math.inf, math.inf)
+            if self.robust_gate is None
+            else (float(chi2.ppf(self.robust_gate, 1)), float(chi2.ppf(self.robust_gate, 2)))
+        )
         self._Re = self.earth_radius / (1.0 - self.refraction)
         self._q = self.sigma_a**2
         self._horizons = np.array(self.horizons, dtype=np.float64)
@@ -921,6 +973,7 @@ class WorldTracker:
         old = self._n
         shapes: dict[str, tuple[tuple[int, ...], float, type]] = {
             "_last": ((size,), np.nan, np.float64),
+            "_seen": ((size,), np.nan, np.float64),
             "_ready": ((size,), False, np.bool_),
             "_Xe": ((size, 4), 0.0, np.float64),
             "_Pe": ((size, 4, 4), 0.0, np.float64),
@@ -946,6 +999,7 @@ class WorldTracker:
             self._alloc(2 * self._n)
         s = self._free.pop()
         self._last[s] = np.nan
+        self._seen[s] = np.nan
         self._ready[s] = False
         for pre in ("_g", "_d"):
             getattr(self, pre + "count")[s] = 0
@@ -1049,13 +1103,22 @@ class WorldTracker:
         last = self._last[slots]
         dt = np.where(np.isnan(last), 0.0, t - last)
         self._last[slots] = t
+        # time since each track's last measured angles [s] (inf: none yet): the diffuse
+        # RLS restarts after a gap of missing samples as after a gap between updates
+        measured = np.isfinite(az) & np.isfinite(dep)
+        seen = self._seen[slots]
+        unseen = np.where(np.isnan(seen), np.inf, t - seen)
+        self._seen[slots[measured]] = t
 
         fix = self._fix(az, dep, Sigma, h, platform.north, platform.east, sp2)
         out: dict[str, WorldEstimates] = {}
         if "geometry" in self.estimators:
             out["geometry"] = self._geometry(t, ids, slots, fix)
         if "diffuse-rls" in self.estimators:
-            out["diffuse-rls"] = self._diffuse(t, ids, slots, dt, az, dep, Sigma, h, sp2, platform)
+            stale = measured & np.isfinite(unseen) & (unseen > self.max_gap)
+            out["diffuse-rls"] = self._diffuse(
+                t, ids, slots, dt, stale, az, dep, Sigma, h, sp2, platform
+            )
         if "ekf" in self.estimators or "ukf" in self.estimators:
             starting = self._start_filters(slots, dep, Sigma, h, fix)
             z = np.stack([az, dep], axis=-1)
@@ -1151,6 +1214,7 @@ class WorldTracker:
         ids: NDArray[np.int64],
         slots: NDArray[np.int64],
         dt: FloatArray,
+        stale: NDArray[np.bool_],
         az: FloatArray,
         dep: FloatArray,
         Sigma: FloatArray,
@@ -1160,7 +1224,7 @@ class WorldTracker:
     ) -> WorldEstimates:
         k = ids.shape[0]
         T = self._T
-        reset = dt > self.max_gap
+        reset = (dt > self.max_gap) | stale
         if T is None:
             missing = np.zeros(k, dtype=np.int64)
             steps = np.zeros(0, dtype=np.int64)
@@ -1250,7 +1314,7 @@ class WorldTracker:
             bank = _ukf_bank if name == "ukf" else _ekf_bank
             bad = bank(
                 slots[run], X, P, dt[run], self._q, z[run], Sigma[run], on, oe, h, sp2,
-                self._Re, self.curved, self._dip(h), nis_run,
+                self._Re, self.curved, self._dip(h), nis_run, self._gate[0], self._gate[1],
             )  # fmt: skip
             if bad >= 0:
                 raise np.linalg.LinAlgError(
