@@ -511,6 +511,11 @@ def _shear_half_kernel(src, starts, fy, r0, r1, out):  # pragma: no cover - comp
             oi[j] = quarter * ((a[2 * j] + a[2 * j + 1]) + (b[2 * j] + b[2 * j + 1]))
 
 
+_REFINE_FLOOR = 0.15
+"""Least mask threshold of the candidate refinement as a fraction of the candidate's 95th
+percentile contrast (``ClassicalShipDetector._refine_mask``)."""
+
+
 def _percentile(a: NDArray, q: float) -> float:
     """``np.percentile(a, q)`` (linear method) of a float32 array, from one partition
     (the next order statistic is the least value above it): the same number."""
@@ -821,8 +826,9 @@ class ClassicalShipDetector:
        ``merge_gap`` × the smaller height on the other.
     5. Inside each candidate, at full resolution, an object mask — ``refine="mask"``
        (default, :meth:`_refine_mask`): the pixels whose noise-normalised contrast
-       against the level's CFAR backgrounds exceeds 0.4 × its 95th percentile in the
-       candidate (the components that touch it); ``refine="flank"``
+       against the level's CFAR backgrounds exceeds 0.4 × its 95th percentile p in the
+       candidate, or the detection threshold where that is lower (at least 0.15 p), in
+       the components that touch it; ``refine="flank"``
        (:meth:`_refine`, :meth:`_segment`): the object against a background of its own
        (per line parallel to the horizon, from flanks 1.5–3.5 object widths away), by
        polarity, with hysteresis, the window grown until the whole ship is in it —
@@ -1531,7 +1537,9 @@ class ClassicalShipDetector:
         (class docstring, step 5): in the candidate's box plus a margin (a quarter of
         its height and the level's factor, at least two working pixels), the pixels
         whose noise-normalised contrast against the level's CFAR backgrounds (luma and
-        chroma) exceeds 0.4 × its 95th percentile over the candidate, in the components
+        chroma) exceeds 0.4 × its 95th percentile p over the candidate — or, where that is
+        higher, the detection threshold itself, but at least 0.15 p (a superstructure
+        five times fainter than its hull is still part of the ship) —, in the components
         that touch the candidate; then :meth:`_ships` (half-covered pixels, sub-pixel
         water line, ships whose water lines jump)."""
         sx, sy = fr.sx, fr.sy
@@ -1585,7 +1593,11 @@ class ClassicalShipDetector:
         peak = _percentile(core, 95.0) if core.size >= 20 else float(core.max())
         if peak <= 0:
             return []
-        obj = (res > 0.4 * peak).view(np.uint8)
+        # a pixel as strong as a detection belongs to the object even where a much
+        # stronger part (a dark hull under a pale superstructure) sets the 95th
+        # percentile; never below a fraction of it (the strong part's halo)
+        thr = min(0.4 * peak, max(self.threshold, _REFINE_FLOOR * peak))
+        obj = (res > thr).view(np.uint8)
         n, labels = cv2.connectedComponents(obj, connectivity=8)
         touching = np.zeros(n, dtype=bool)
         touching[labels[cy0:cy1, cx0:cx1].ravel()] = True
