@@ -119,10 +119,10 @@ fixed water line (session 4, before :data:`WORLD_ROBUST_GATE`): 0.2 → 42.6 m, 
 WORLD_ROBUST_GATE = 0.99
 """Gate probability of the world EKF/UKF's robust update (``WorldTracker(robust_gate=)``):
 a water line whose innovation is beyond the 99 % χ² gate — two ships merged into one box,
-a box on a superstructure — is down-weighted instead of moving the range. Measured (before the
-detector's session-5 refinement change): demo
-EKF 37.3 → 34.9 m (geometry 41.1 m; gate 0.95: 36.5 m), uav-sea 27.6 → 21.0 m, range-1km
-4.1 → 2.9 % at 1 km (``docs/results/track/measure.py``)."""
+a box on a superstructure — is down-weighted instead of moving the range. Measured before
+the detector's session-5 refinement change: demo EKF 37.3 → 34.9 m (geometry 41.1 m; gate
+0.95: 36.5 m), uav-sea 27.6 → 21.0 m, range-1km 4.1 → 2.9 % at 1 km
+(``docs/results/track/measure.py``)."""
 
 MIN_TRUTH_PX = 5.0
 """Truth boxes less than this tall [px] (vessels far beyond a classical detector's reach)
