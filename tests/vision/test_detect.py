@@ -609,6 +609,27 @@ def test_thin_mast_is_inside_the_box(refine):
     assert abs(det.y[found[0]] - 218.2) <= 1.0  # a 0.7 px mast 16 px high: the box's top
 
 
+def test_pale_superstructure_five_times_fainter_than_its_hull_is_inside_the_box():
+    """A dark hull (−80 grey levels from the sea) under a pale superstructure (+16): the
+    superstructure is far above the noise (2 grey levels) but below 0.4 × the hull's
+    contrast; it is part of the ship, and the box's top is its top. The default
+    refinement only: ``refine="flank"`` seeds each polarity at half the candidate's peak
+    and leaves such a superstructure out."""
+    rng = np.random.default_rng(4321)
+    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
+    img = base.copy()
+    t = box_ship(img, base, 320.0, 240.5, 60, 6, -80, sup=(0, 0))
+    bg = float(np.median(base[230:250, 260:380]))
+    paint_polygon(img, [(305.0, 224.5), (335.0, 224.5), (335.0, 235.0), (305.0, 235.0)], bg + 16)
+    img = as_u8(cv2.GaussianBlur(img, (0, 0), 0.7) + rng.normal(0, 2.0, img.shape))
+    det = ClassicalShipDetector()(img, horizon=hz)
+    found, n_false = match(det, np.array([t]))
+    assert found[0] >= 0 and n_false == 0
+    k = found[0]
+    assert abs(det.y[k] - 224.5) <= 1.0, det.y[k]  # the superstructure's top
+    assert abs(det.v_wl[k] - 240.5) <= 0.3, det.v_wl[k]  # the hull's water line
+
+
 @pytest.mark.parametrize("refine", REFINE)
 def test_rendered_footage_water_line_matches_truth_within_the_renderers_fill(tmp_path, refine):
     """Rendered H.264 footage (``seawatch.synth.render``): a 50 m ferry 800 m out and a
