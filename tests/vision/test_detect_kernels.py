@@ -10,10 +10,19 @@ two-row objects, flat sea) with fixed seeds.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
-from seawatch.vision.detect import _column_edges, _mad, _theil_sen
+from seawatch.vision.detect import (
+    _column_edges,
+    _hull_contrast_kernel,
+    _level_breaks_kernel,
+    _mad,
+    _median3,
+    _theil_sen,
+)
 
 
 def _column_edges_ref(
@@ -162,3 +171,67 @@ def test_theil_sen_kernel_equals_numpy():
             assert all(type(v) is float for v in got)
     same_x = np.full(5, 3.0)  # no pair with a slope: slope 0
     assert _theil_sen(same_x, np.arange(5.0), 1.0) == _theil_sen_ref(same_x, np.arange(5.0), 1.0)
+
+
+def _hull_contrast_ref(rgb: np.ndarray, cols: np.ndarray, bottom: np.ndarray):
+    """The numpy form of the hull/sea levels in :func:`seawatch.vision.detect._frame_ships`."""
+    last = rgb.shape[0] - 1
+    pick = [rgb[np.clip(bottom + k, 0, last), cols] for k in (-3, -2, -2, 3, 4, 5)]
+    sea = _median3(*pick[3:])
+    hull = _median3(*pick[:3]) - sea
+    noise = 1.4826 * float(np.median(np.abs(np.stack(pick[3:]) - sea)))
+    return hull, noise
+
+
+def _level_breaks_ref(c: np.ndarray, e: np.ndarray, jump: float):
+    """The numpy form of the breaks of :func:`seawatch.vision.detect._waterline_levels`."""
+    n = e.size
+    em = e.copy()
+    em[1:-1] = _median3(e[:-2], e[1:-1], e[2:])
+    d = np.diff(e)
+    noise = _mad(d) / math.sqrt(2.0)
+    J = max(jump, 4.0 * noise)
+    ext = np.r_[em[0], em[0], em, em[-1], em[-1]]
+    med = _median3(ext[:-2], ext[1:-1], ext[2:])
+    step = np.abs(med[3 : n + 2] - med[: n - 1])
+    step[np.diff(c) > 2] = 0.0
+    breaks = [
+        i for i in range(n - 1) if step[i] >= J and step[i] == step[max(0, i - 2) : i + 3].max()
+    ]
+    return breaks, J
+
+
+@pytest.mark.parametrize("nch", [1, 3])
+def test_hull_contrast_kernel_equals_numpy(nch):
+    rng = np.random.default_rng(21 + nch)
+    for _ in range(200):
+        h, w = int(rng.integers(1, 25)), int(rng.integers(1, 50))
+        rgb = rng.normal(100, rng.uniform(0.5, 30), (h, w, nch)).astype(np.float32)
+        if rng.random() < 0.5:
+            rgb = np.round(rgb)  # integer levels: many ties
+        cols = np.flatnonzero(rng.random(w) < 0.7)
+        if cols.size == 0:
+            cols = np.array([0])
+        bottom = rng.integers(0, h, cols.size)  # rows ± 3 … 5 clipped to the crop
+        hull, noise = _hull_contrast_kernel(rgb, cols, bottom)
+        ref_hull, ref_noise = _hull_contrast_ref(rgb, cols, bottom)
+        np.testing.assert_array_equal(hull, ref_hull)
+        assert hull.dtype == ref_hull.dtype
+        assert noise == ref_noise
+
+
+def test_level_breaks_kernel_equals_numpy():
+    rng = np.random.default_rng(31)
+    for _ in range(400):
+        n = int(rng.integers(9, 120))
+        c = np.cumsum(rng.choice([1, 1, 1, 2, 3, 5], n)) + int(rng.integers(0, 50))
+        e = 20.0 + rng.normal(0, rng.uniform(0.05, 0.6), n)
+        for _ in range(int(rng.integers(0, 4))):  # steps: a second ship's water line
+            e[int(rng.integers(1, n)) :] += rng.uniform(-3.0, 3.0)
+        if rng.random() < 0.3:
+            e = np.round(e * 4) / 4  # quantised edges: equal steps, ties for the maximum
+        jump = float(rng.choice([0.5, 1.0, 2.0]))
+        breaks, J = _level_breaks_kernel(c.astype(np.int64), e, jump)
+        ref_breaks, ref_J = _level_breaks_ref(c, e, jump)
+        assert breaks.tolist() == ref_breaks
+        assert J == ref_J

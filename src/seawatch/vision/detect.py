@@ -2001,9 +2001,21 @@ _WL_MIN_COLUMNS = 16
 
 
 @njit(cache=True, nogil=True)
-def _median3_f32(a, b, c):  # pragma: no cover - compiled
-    """The middle one of three values (what ``np.median`` of the three returns)."""
+def _mid3(a, b, c):  # pragma: no cover - compiled
+    """The middle one of three values (what ``np.median`` of the three and
+    :func:`_median3` give, for values that are not NaN)."""
     return max(min(a, b), min(max(a, b), c))
+
+
+@njit(cache=True, nogil=True)
+def _median_f32(a):  # pragma: no cover - compiled
+    """``float(np.median(a))`` of a non-empty float32 array (sorted in place): the middle
+    value, or the float32 mean of the two middle ones, as numpy computes it."""
+    a.sort()
+    h = a.size // 2
+    if a.size % 2 == 1:
+        return np.float64(a[h])
+    return np.float64((a[h - 1] + a[h]) / np.float32(2.0))
 
 
 @njit(cache=True, nogil=True)
@@ -2057,19 +2069,13 @@ def _column_edges_kernel(g, obj, quantum):  # pragma: no cover - compiled
         r3, r4, r5 = min(b + 3, H - 1), min(b + 4, H - 1), min(b + 5, H - 1)
         for ch in range(nch):
             s0, s1, s2 = g[r3, c, ch], g[r4, c, ch], g[r5, c, ch]
-            m = _median3_f32(s0, s1, s2)
+            m = _mid3(s0, s1, s2)
             i_s[j, ch] = m
             dev[k] = abs(s0 - m)
             dev[k + 1] = abs(s1 - m)
             dev[k + 2] = abs(s2 - m)
             k += 3
-    dev.sort()
-    h = k // 2
-    if k % 2 == 1:
-        med = np.float64(dev[h])
-    else:
-        med = np.float64((dev[h - 1] + dev[h]) / np.float32(2.0))
-    sigma = max(1.4826 * med, quantum, 1e-6)
+    sigma = max(1.4826 * _median_f32(dev), quantum, 1e-6)
     weak_below = np.float32((4.0 * sigma) ** 2 * nch)
     i_h = np.empty(nch, np.float32)
     axis = np.empty(nch, np.float32)
@@ -2085,7 +2091,7 @@ def _column_edges_kernel(g, obj, quantum):  # pragma: no cover - compiled
         for ch in range(nch):
             a0, a1, a2 = g[ra, c, ch], g[rb, c, ch], g[rc, c, ch]
             if n_in >= 3:
-                i_h[ch] = _median3_f32(a0, a1, a2)
+                i_h[ch] = _mid3(a0, a1, a2)
             elif n_in == 2:
                 i_h[ch] = np.float32(0.5) * (a0 + a1)
             else:
@@ -2261,6 +2267,45 @@ def _hull_waterline(
     return u, _theil_sen_at(cols[keep].astype(np.float64), edge[keep], u)
 
 
+@njit(cache=True, nogil=True)
+def _level_breaks_kernel(c, e, jump):  # pragma: no cover - compiled
+    """The breaks of :func:`_waterline_levels` along measured edges ``e`` [px] at columns
+    ``c``, and the jump ``J`` [px] they pass. Compiled because the numpy form (running
+    medians, a MAD, a Python loop over the columns) was call overhead; the same float64
+    operations, so the same numbers."""
+    n = e.size
+    em = e.copy()
+    for i in range(1, n - 1):
+        em[i] = _mid3(e[i - 1], e[i], e[i + 1])
+    d = np.empty(n - 1, np.float64)
+    for i in range(n - 1):
+        d[i] = e[i + 1] - e[i]
+    noise = 1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0)
+    J = max(jump, 4.0 * noise)
+    # between columns i and i + 1: the medians of the three edges after and before
+    ext = np.empty(n + 4, np.float64)
+    ext[0] = ext[1] = em[0]
+    ext[2 : n + 2] = em
+    ext[n + 2] = ext[n + 3] = em[n - 1]
+    med = np.empty(n + 2, np.float64)  # centred, j = -1 … n
+    for i in range(n + 2):
+        med[i] = _mid3(ext[i], ext[i + 1], ext[i + 2])
+    step = np.empty(n - 1, np.float64)
+    for i in range(n - 1):
+        step[i] = 0.0 if c[i + 1] - c[i] > 2 else abs(med[i + 3] - med[i])
+    breaks = np.empty(n - 1, np.int64)
+    nb = 0
+    for i in range(n - 1):
+        if step[i] >= J:
+            top = step[max(0, i - 2)]
+            for k in range(max(0, i - 2) + 1, min(n - 1, i + 3)):
+                top = max(top, step[k])
+            if step[i] == top:
+                breaks[nb] = i
+                nb += 1
+    return breaks[:nb], J
+
+
 def _waterline_levels(
     cols: NDArray,
     edge: NDArray,
@@ -2295,19 +2340,12 @@ def _waterline_levels(
     if n < 9:
         return None
     c, e = cols[ok], edge[ok]
-    em = e.copy()
-    em[1:-1] = _median3(e[:-2], e[1:-1], e[2:])
-    d = np.diff(e)
-    noise = _mad(d) / math.sqrt(2.0)
-    J = max(jump, 4.0 * noise)
-    # between columns i and i + 1: the medians of the three edges after and before
-    ext = np.r_[em[0], em[0], em, em[-1], em[-1]]
-    med = _median3(ext[:-2], ext[1:-1], ext[2:])  # centred, j = -1 … n
-    step = np.abs(med[3 : n + 2] - med[: n - 1])
-    step[np.diff(c) > 2] = 0.0
-    breaks = [
-        i for i in range(n - 1) if step[i] >= J and step[i] == step[max(0, i - 2) : i + 3].max()
-    ]
+    found, J = _level_breaks_kernel(
+        np.ascontiguousarray(c, dtype=np.int64),
+        np.ascontiguousarray(e, dtype=np.float64),
+        float(jump),
+    )
+    breaks = found.tolist()
     if not breaks:
         return None
     runs = []
@@ -2345,6 +2383,36 @@ def _waterline_levels(
     return out
 
 
+@njit(cache=True, nogil=True)
+def _hull_contrast_kernel(rgb, cols, bottom):  # pragma: no cover - compiled
+    """Per column ``cols[j]`` of a float32 (H, W, C) crop whose lowest mask row is
+    ``bottom[j]``: the hull's level less the sea's (the middle of rows ``b − 3, b − 2,
+    b − 2`` less that of rows ``b + 3 … b + 5``, rows clipped to the crop) and the sea
+    rows' noise ``1.4826 · median |sea − its column's level|`` [units]. Compiled because
+    the numpy form (six gathers, a stack and a median per object) was call overhead; the
+    same float32 operations, so the same numbers."""
+    H = rgb.shape[0]
+    nch = rgb.shape[2]
+    n = cols.size
+    hull = np.empty((n, nch), np.float32)
+    dev = np.empty(3 * n * nch, np.float32)
+    k = 0
+    for j in range(n):
+        c = cols[j]
+        b = bottom[j]
+        h3, h2 = min(max(b - 3, 0), H - 1), min(max(b - 2, 0), H - 1)
+        s3, s4, s5 = min(max(b + 3, 0), H - 1), min(max(b + 4, 0), H - 1), min(max(b + 5, 0), H - 1)
+        for ch in range(nch):
+            a0, a1, a2 = rgb[s3, c, ch], rgb[s4, c, ch], rgb[s5, c, ch]
+            sea = _mid3(a0, a1, a2)
+            hull[j, ch] = _mid3(rgb[h3, c, ch], rgb[h2, c, ch], rgb[h2, c, ch]) - sea
+            dev[k] = abs(a0 - sea)
+            dev[k + 1] = abs(a1 - sea)
+            dev[k + 2] = abs(a2 - sea)
+            k += 3
+    return hull, 1.4826 * _median_f32(dev)
+
+
 def _frame_ships(
     fr: _Frame, obj: NDArray[np.bool_], x0: int, y0: int, colour: bool = False
 ) -> list[tuple[int, int, int, int, float | None, float | None]]:
@@ -2373,11 +2441,7 @@ def _frame_ships(
         rgb = cv2.cvtColor(crop, cv2.COLOR_BGR2YCrCb).astype(np.float32)
     else:
         rgb = raw if raw.ndim == 3 else raw[:, :, None]
-    last = rgb.shape[0] - 1
-    pick = [rgb[np.clip(bottom + k, 0, last), cols] for k in (-3, -2, -2, 3, 4, 5)]
-    sea = _median3(*pick[3:])
-    hull = _median3(*pick[:3]) - sea
-    noise = 1.4826 * float(np.median(np.abs(np.stack(pick[3:]) - sea)))
+    hull, noise = _hull_contrast_kernel(np.ascontiguousarray(rgb), cols, bottom)
     groups = _waterline_levels(cols, edge, hull=hull, sigma=max(noise, 0.5 * fr.quantum))
     if groups is None:
         rb = int(bottom.max())
