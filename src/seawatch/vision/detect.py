@@ -2012,6 +2012,148 @@ _WL_MIN_COLUMNS = 16
 """Hull columns from which an object without a measurable water line is no ship."""
 
 
+@njit(cache=True, nogil=True)
+def _mid3(a, b, c):  # pragma: no cover - compiled
+    """The middle one of three values (what ``np.median`` of the three and
+    :func:`_median3` give, for values that are not NaN)."""
+    return max(min(a, b), min(max(a, b), c))
+
+
+@njit(cache=True, nogil=True)
+def _median_f32(a):  # pragma: no cover - compiled
+    """``float(np.median(a))`` of a non-empty float32 array (sorted in place): the middle
+    value, or the float32 mean of the two middle ones, as numpy computes it."""
+    a.sort()
+    h = a.size // 2
+    if a.size % 2 == 1:
+        return np.float64(a[h])
+    return np.float64((a[h - 1] + a[h]) / np.float32(2.0))
+
+
+@njit(cache=True, nogil=True)
+def _column_edges_kernel(g, obj, quantum):  # pragma: no cover - compiled
+    """:func:`_column_edges` on a float32 (H, W, C) crop ``g`` and its (H, W) mask.
+
+    Compiled because the numpy form ran a dozen gathers, stacks and medians of a few
+    values per object (about 0.8 ms per object, most of it call overhead). It repeats
+    numpy's float32 arithmetic step by step (channel sums left to right, as numpy's sum
+    over a short last axis; the 4 σ test in float32, as numpy compares a float32 array
+    with a Python float), so the edges are the same numbers.
+    """
+    H, W, nch = g.shape
+    n = 0
+    for c in range(W):
+        for r in range(H):
+            if obj[r, c]:
+                n += 1
+                break
+    cols = np.empty(n, np.int64)
+    bottom = np.empty(n, np.int64)
+    top = np.empty(n, np.int64)
+    edge = np.empty(n, np.float64)
+    if n == 0:
+        return cols, bottom, top, edge
+    j = 0
+    for c in range(W):
+        t = -1
+        for r in range(H):
+            if obj[r, c]:
+                t = r
+                break
+        if t < 0:
+            continue
+        b = t
+        for r in range(H - 1, t - 1, -1):
+            if obj[r, c]:
+                b = r
+                break
+        cols[j] = c
+        top[j] = t
+        bottom[j] = b
+        j += 1
+    # sea level per column: the middle of rows b + 3 … b + 5; σ from all their deviations
+    i_s = np.empty((n, nch), np.float32)
+    dev = np.empty(3 * n * nch, np.float32)
+    k = 0
+    for j in range(n):
+        c = cols[j]
+        b = bottom[j]
+        r3, r4, r5 = min(b + 3, H - 1), min(b + 4, H - 1), min(b + 5, H - 1)
+        for ch in range(nch):
+            s0, s1, s2 = g[r3, c, ch], g[r4, c, ch], g[r5, c, ch]
+            m = _mid3(s0, s1, s2)
+            i_s[j, ch] = m
+            dev[k] = abs(s0 - m)
+            dev[k + 1] = abs(s1 - m)
+            dev[k + 2] = abs(s2 - m)
+            k += 3
+    sigma = max(1.4826 * _median_f32(dev), quantum, 1e-6)
+    weak_below = np.float32((4.0 * sigma) ** 2 * nch)
+    i_h = np.empty(nch, np.float32)
+    axis = np.empty(nch, np.float32)
+    for j in range(n):
+        c = cols[j]
+        b = bottom[j]
+        t = top[j]
+        start = b - 1  # the transition window: rows b - 1 ... b + 2
+        n_in = int(start - 1 >= t) + int(start - 2 >= t) + int(start - 3 >= t)
+        ra = min(max(start - 1, 0), H - 1)
+        rb = min(max(start - 2, 0), H - 1)
+        rc = min(max(start - 3, 0), H - 1)
+        for ch in range(nch):
+            a0, a1, a2 = g[ra, c, ch], g[rb, c, ch], g[rc, c, ch]
+            if n_in >= 3:
+                i_h[ch] = _mid3(a0, a1, a2)
+            elif n_in == 2:
+                i_h[ch] = np.float32(0.5) * (a0 + a1)
+            else:
+                i_h[ch] = a0
+        if n_in == 0:  # no mask row above the window: the most contrasted mask pixel
+            pick = 0
+            best = np.float32(0.0)
+            for kk in range(3):
+                rr = b - kk
+                if rr >= t:
+                    ri = min(max(rr, 0), H - 1)
+                    acc = np.float32(0.0)
+                    for ch in range(nch):
+                        e = g[ri, c, ch] - i_s[j, ch]
+                        acc = e * e if ch == 0 else acc + e * e
+                    dist = np.sqrt(acc)
+                else:
+                    dist = np.float32(-1.0)
+                if kk == 0 or dist > best:
+                    best = dist
+                    pick = kk
+            ri = min(max(b - pick, 0), H - 1)
+            for ch in range(nch):
+                i_h[ch] = g[ri, c, ch]
+            start = b - pick
+        norm2 = np.float32(0.0)
+        for ch in range(nch):
+            axis[ch] = i_h[ch] - i_s[j, ch]
+            sq = axis[ch] * axis[ch]
+            norm2 = sq if ch == 0 else norm2 + sq
+        if norm2 < weak_below:
+            edge[j] = np.nan
+            continue
+        for ch in range(nch):
+            axis[ch] = axis[ch] / norm2
+        e_c = np.float64(start) - 0.5
+        for kk in range(6):  # window rows start … b + 2 (at most 6)
+            r = start + kk
+            if r > b + 2:
+                continue
+            ri = min(max(r, 0), H - 1)
+            cov = np.float32(0.0)
+            for ch in range(nch):
+                p = (g[ri, c, ch] - i_s[j, ch]) * axis[ch]
+                cov = p if ch == 0 else cov + p
+            e_c += np.float64(min(max(cov, np.float32(0.0)), np.float32(1.0)))
+        edge[j] = e_c
+    return cols, bottom, top, edge
+
+
 def _column_edges(
     raw: NDArray, obj: NDArray[np.bool_], quantum: float = 0.0
 ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
@@ -2020,65 +2162,65 @@ def _column_edges(
     :func:`_edge_waterline`). ``raw`` is the unsmoothed (H, W) grey or (H, W, C) colour
     crop under the mask (rows past it repeat its last row). For colour, each pixel is
     projected on the axis from the sea's colour to the hull's, ``(c − c_s)·(c_h − c_s) /
-    |c_h − c_s|²`` (linear in the hull's coverage of the pixel, like the grey level)."""
-    H = obj.shape[0]
-    cols = np.flatnonzero(obj.any(axis=0))
-    bottom = H - 1 - np.argmax(obj[::-1, cols], axis=0)
-    top = np.argmax(obj[:, cols], axis=0)
+    |c_h − c_s|²`` (linear in the hull's coverage of the pixel, like the grey level).
+    Compiled: :func:`_column_edges_kernel`."""
     g = raw if raw.dtype == np.float32 else raw.astype(np.float32)
     if g.ndim == 2:
         g = g[:, :, None]
-    nch = g.shape[2]
-
-    def at(r: NDArray) -> NDArray:  # (columns, channels)
-        return g[np.clip(r, 0, H - 1), cols]
-
-    sea = np.stack([at(bottom + k) for k in (3, 4, 5)])
-    i_s = np.median(sea, axis=0)
-    sigma = max(1.4826 * float(np.median(np.abs(sea - i_s))), quantum, 1e-6)
-    start = bottom - 1  # the transition window: rows b_c - 1 ... b_c + 2
-    above = np.stack([at(start - k) for k in (1, 2, 3)])
-    n_in = ((start - 1) >= top).astype(int) + ((start - 2) >= top) + ((start - 3) >= top)
-    n_in = n_in[:, None]
-    i_h = np.where(
-        n_in >= 3,
-        np.median(above, axis=0),
-        np.where(n_in == 2, 0.5 * (above[0] + above[1]), above[0]),
+    return _column_edges_kernel(
+        np.ascontiguousarray(g), np.ascontiguousarray(obj, dtype=np.bool_), float(quantum)
     )
-    thin = n_in[:, 0] == 0
-    if thin.any():  # no mask row above the window: the most contrasted mask pixel
-        span = np.stack([at(bottom - k) for k in (0, 1, 2)])
-        inside = np.stack([(bottom - k) >= top for k in (0, 1, 2)])
-        dist = np.sqrt(np.sum((span - i_s) ** 2, axis=2))
-        pick = np.argmax(np.where(inside, dist, -1.0), axis=0)
-        i_h = np.where(thin[:, None], span[pick, np.arange(cols.size)], i_h)
-        start = np.where(thin, bottom - pick, start)
-    axis = i_h - i_s
-    norm2 = np.sum(axis * axis, axis=1)
-    weak = norm2 < (4.0 * sigma) ** 2 * nch
-    axis = np.where(weak[:, None], 0.0, axis / np.where(weak, 1.0, norm2)[:, None])
-    edge = start - 0.5
-    for k in range(6):  # window rows start … b_c + 2 (at most 6)
-        r = start + k
-        cov = np.clip(np.sum((at(r) - i_s) * axis, axis=1), 0.0, 1.0)
-        edge = edge + np.where(r <= bottom + 2, cov, 0.0)
-    return cols, bottom, top, np.where(weak, np.nan, edge)
+
+
+@njit(cache=True, nogil=True)
+def _theil_sen_kernel(x, y, u, sub):  # pragma: no cover - compiled
+    """:func:`_theil_sen` for at least two points, ``sub`` the indices of the points
+    whose pairwise slopes count. Compiled because the numpy form (index pairs, fancy
+    indexing, three medians) cost about 0.3 ms a line in call overhead, for a few
+    hundred pairs; the same float64 operations, so the same numbers."""
+    m = sub.size
+    slopes = np.empty(m * (m - 1) // 2, np.float64)
+    k = 0
+    for i in range(m):
+        xi = x[sub[i]]
+        yi = y[sub[i]]
+        for j in range(i + 1, m):
+            dx = x[sub[j]] - xi
+            if dx != 0:
+                slopes[k] = (y[sub[j]] - yi) / dx
+                k += 1
+    slope = np.median(slopes[:k]) if k > 0 else 0.0
+    r = np.empty(x.size, np.float64)
+    for i in range(x.size):
+        r[i] = y[i] - slope * (x[i] - u)
+    v = np.median(r)
+    return v, slope, 1.4826 * np.median(np.abs(r - v))
+
+
+@functools.lru_cache(maxsize=256)
+def _theil_sen_subset(n: int) -> NDArray[np.int64]:
+    """Indices of the at most 24 evenly spread points of ``n`` whose pairwise slopes
+    :func:`_theil_sen` takes (read-only, cached per ``n``)."""
+    sub = np.linspace(0, n - 1, 24).round().astype(np.int64) if n > 24 else np.arange(n)
+    sub.flags.writeable = False
+    return sub
 
 
 def _theil_sen(x: NDArray, y: NDArray, u: float) -> tuple[float, float, float]:
     """The Theil–Sen line through ``(x, y)`` (median of the pairwise slopes of at most 24
     evenly spread points; median intercept): its value at ``u``, its slope and the
-    robust spread of the residuals about it (1.4826 · MAD)."""
+    robust spread of the residuals about it (1.4826 · MAD). Compiled:
+    :func:`_theil_sen_kernel`."""
     n = x.size
     if n < 2:
         return float(y[0]), 0.0, 0.0
-    sub = np.linspace(0, n - 1, 24).round().astype(int) if n > 24 else np.arange(n)
-    i, j = np.triu_indices(sub.size, 1)
-    dx = x[sub][j] - x[sub][i]
-    ok = dx != 0
-    slope = float(np.median((y[sub][j] - y[sub][i])[ok] / dx[ok])) if ok.any() else 0.0
-    r = y - slope * (x - u)
-    return float(np.median(r)), slope, _mad(r)
+    v, slope, spread = _theil_sen_kernel(
+        np.ascontiguousarray(x, dtype=np.float64),
+        np.ascontiguousarray(y, dtype=np.float64),
+        float(u),
+        _theil_sen_subset(n),
+    )
+    return float(v), float(slope), float(spread)
 
 
 def _theil_sen_at(x: NDArray, y: NDArray, u: float) -> float:
@@ -2137,6 +2279,45 @@ def _hull_waterline(
     return u, _theil_sen_at(cols[keep].astype(np.float64), edge[keep], u)
 
 
+@njit(cache=True, nogil=True)
+def _level_breaks_kernel(c, e, jump):  # pragma: no cover - compiled
+    """The breaks of :func:`_waterline_levels` along measured edges ``e`` [px] at columns
+    ``c``, and the jump ``J`` [px] they pass. Compiled because the numpy form (running
+    medians, a MAD, a Python loop over the columns) was call overhead; the same float64
+    operations, so the same numbers."""
+    n = e.size
+    em = e.copy()
+    for i in range(1, n - 1):
+        em[i] = _mid3(e[i - 1], e[i], e[i + 1])
+    d = np.empty(n - 1, np.float64)
+    for i in range(n - 1):
+        d[i] = e[i + 1] - e[i]
+    noise = 1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0)
+    J = max(jump, 4.0 * noise)
+    # between columns i and i + 1: the medians of the three edges after and before
+    ext = np.empty(n + 4, np.float64)
+    ext[0] = ext[1] = em[0]
+    ext[2 : n + 2] = em
+    ext[n + 2] = ext[n + 3] = em[n - 1]
+    med = np.empty(n + 2, np.float64)  # centred, j = -1 … n
+    for i in range(n + 2):
+        med[i] = _mid3(ext[i], ext[i + 1], ext[i + 2])
+    step = np.empty(n - 1, np.float64)
+    for i in range(n - 1):
+        step[i] = 0.0 if c[i + 1] - c[i] > 2 else abs(med[i + 3] - med[i])
+    breaks = np.empty(n - 1, np.int64)
+    nb = 0
+    for i in range(n - 1):
+        if step[i] >= J:
+            top = step[max(0, i - 2)]
+            for k in range(max(0, i - 2) + 1, min(n - 1, i + 3)):
+                top = max(top, step[k])
+            if step[i] == top:
+                breaks[nb] = i
+                nb += 1
+    return breaks[:nb], J
+
+
 def _waterline_levels(
     cols: NDArray,
     edge: NDArray,
@@ -2171,19 +2352,12 @@ def _waterline_levels(
     if n < 9:
         return None
     c, e = cols[ok], edge[ok]
-    em = e.copy()
-    em[1:-1] = _median3(e[:-2], e[1:-1], e[2:])
-    d = np.diff(e)
-    noise = _mad(d) / math.sqrt(2.0)
-    J = max(jump, 4.0 * noise)
-    # between columns i and i + 1: the medians of the three edges after and before
-    ext = np.r_[em[0], em[0], em, em[-1], em[-1]]
-    med = _median3(ext[:-2], ext[1:-1], ext[2:])  # centred, j = -1 … n
-    step = np.abs(med[3 : n + 2] - med[: n - 1])
-    step[np.diff(c) > 2] = 0.0
-    breaks = [
-        i for i in range(n - 1) if step[i] >= J and step[i] == step[max(0, i - 2) : i + 3].max()
-    ]
+    found, J = _level_breaks_kernel(
+        np.ascontiguousarray(c, dtype=np.int64),
+        np.ascontiguousarray(e, dtype=np.float64),
+        float(jump),
+    )
+    breaks = found.tolist()
     if not breaks:
         return None
     runs = []
@@ -2221,6 +2395,36 @@ def _waterline_levels(
     return out
 
 
+@njit(cache=True, nogil=True)
+def _hull_contrast_kernel(rgb, cols, bottom):  # pragma: no cover - compiled
+    """Per column ``cols[j]`` of a float32 (H, W, C) crop whose lowest mask row is
+    ``bottom[j]``: the hull's level less the sea's (the middle of rows ``b − 3, b − 2,
+    b − 2`` less that of rows ``b + 3 … b + 5``, rows clipped to the crop) and the sea
+    rows' noise ``1.4826 · median |sea − its column's level|`` [units]. Compiled because
+    the numpy form (six gathers, a stack and a median per object) was call overhead; the
+    same float32 operations, so the same numbers."""
+    H = rgb.shape[0]
+    nch = rgb.shape[2]
+    n = cols.size
+    hull = np.empty((n, nch), np.float32)
+    dev = np.empty(3 * n * nch, np.float32)
+    k = 0
+    for j in range(n):
+        c = cols[j]
+        b = bottom[j]
+        h3, h2 = min(max(b - 3, 0), H - 1), min(max(b - 2, 0), H - 1)
+        s3, s4, s5 = min(max(b + 3, 0), H - 1), min(max(b + 4, 0), H - 1), min(max(b + 5, 0), H - 1)
+        for ch in range(nch):
+            a0, a1, a2 = rgb[s3, c, ch], rgb[s4, c, ch], rgb[s5, c, ch]
+            sea = _mid3(a0, a1, a2)
+            hull[j, ch] = _mid3(rgb[h3, c, ch], rgb[h2, c, ch], rgb[h2, c, ch]) - sea
+            dev[k] = abs(a0 - sea)
+            dev[k + 1] = abs(a1 - sea)
+            dev[k + 2] = abs(a2 - sea)
+            k += 3
+    return hull, 1.4826 * _median_f32(dev)
+
+
 def _frame_ships(
     fr: _Frame, obj: NDArray[np.bool_], x0: int, y0: int, colour: bool = False
 ) -> list[tuple[int, int, int, int, float | None, float | None]]:
@@ -2249,11 +2453,7 @@ def _frame_ships(
         rgb = cv2.cvtColor(crop, cv2.COLOR_BGR2YCrCb).astype(np.float32)
     else:
         rgb = raw if raw.ndim == 3 else raw[:, :, None]
-    last = rgb.shape[0] - 1
-    pick = [rgb[np.clip(bottom + k, 0, last), cols] for k in (-3, -2, -2, 3, 4, 5)]
-    sea = _median3(*pick[3:])
-    hull = _median3(*pick[:3]) - sea
-    noise = 1.4826 * float(np.median(np.abs(np.stack(pick[3:]) - sea)))
+    hull, noise = _hull_contrast_kernel(np.ascontiguousarray(rgb), cols, bottom)
     groups = _waterline_levels(cols, edge, hull=hull, sigma=max(noise, 0.5 * fr.quantum))
     if groups is None:
         rb = int(bottom.max())
