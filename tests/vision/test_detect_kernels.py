@@ -20,9 +20,13 @@ from seawatch.vision.detect import (
     _hull_contrast_kernel,
     _level_breaks_kernel,
     _mad,
-    _median3,
     _theil_sen,
 )
+
+
+def _median3(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Element-wise median of three arrays (the numpy form the kernels replaced)."""
+    return np.maximum(np.minimum(a, b), np.minimum(np.maximum(a, b), c))
 
 
 def _column_edges_ref(

@@ -1815,13 +1815,6 @@ def _chroma_contrast(
     return out
 
 
-def _median3(a: NDArray, b: NDArray, c: NDArray) -> NDArray:
-    """Element-wise median of three arrays (``np.median(np.stack([a, b, c]), axis=0)``
-    without the sort: this runs per candidate and column, where the sort's overhead
-    dominated)."""
-    return np.maximum(np.minimum(a, b), np.minimum(np.maximum(a, b), c))
-
-
 def _row_median(values: NDArray, mask: NDArray[np.bool_]) -> NDArray:
     """Median of each row's ``values`` where ``mask`` (NaN for a row without any):
     ``np.nanmedian`` of the masked rows from one sort, without its masked-array path."""
@@ -2014,8 +2007,8 @@ _WL_MIN_COLUMNS = 16
 
 @njit(cache=True, nogil=True)
 def _mid3(a, b, c):  # pragma: no cover - compiled
-    """The middle one of three values (what ``np.median`` of the three and
-    :func:`_median3` give, for values that are not NaN)."""
+    """The middle one of three values (what ``np.median`` of the three gives, for values
+    that are not NaN)."""
     return max(min(a, b), min(max(a, b), c))
 
 
