@@ -1,4 +1,4 @@
-"""seawatch.vision.detect: classical ship detector, callable and ONNX detectors.
+"""Ship detectors: the classical one (vision.detect), callable and ONNX ones (vision.external).
 
 Truths: synthetic sea scenes drawn here with known ship boxes and water lines (textured
 sea with perspective waves and noise, small and large, dark and bright ships with hull
@@ -25,15 +25,13 @@ import pytest
 
 from seawatch.vision.detect import (
     DETECTION_COLUMNS,
-    CallableDetector,
     ClassicalShipDetector,
     Detections,
     Detector,
-    OnnxDetector,
-    decode_yolo,
     sea_region,
     waterline_points,
 )
+from seawatch.vision.external import CallableDetector, OnnxDetector, decode_yolo
 
 MARDCT = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "mardct_ir3"
 needs_mardct = pytest.mark.skipif(

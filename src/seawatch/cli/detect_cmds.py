@@ -139,7 +139,8 @@ def detect(
     Example: [cyan]seawatch detect clip.mp4 --json -o boxes.csv[/]
     """
     from seawatch.io.video import VideoReader
-    from seawatch.vision.detect import ClassicalShipDetector, OnnxDetector
+    from seawatch.vision.detect import ClassicalShipDetector
+    from seawatch.vision.external import OnnxDetector
 
     with exit_codes(), warnings_to_stderr():
         if end is not None and end <= start:

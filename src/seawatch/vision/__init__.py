@@ -8,18 +8,18 @@
 * :mod:`seawatch.vision.horizon` — the sea horizon per frame (``detect_horizon``), its
   temporal smoothing (``HorizonTracker``) and the sea region below it (``sea_mask``).
 * :mod:`seawatch.vision.detect` — ship boxes with their water-line points: the classical
-  weight-free ``ClassicalShipDetector``, ``OnnxDetector`` (optional onnxruntime) and
-  ``CallableDetector`` for a user's own function.
+  weight-free ``ClassicalShipDetector``; :mod:`seawatch.vision.external` —
+  ``OnnxDetector`` (optional onnxruntime) and ``CallableDetector`` for a user's own
+  function.
 """
 
 from seawatch.vision.detect import (
     DETECTION_COLUMNS,
-    CallableDetector,
     ClassicalShipDetector,
     Detections,
     Detector,
-    OnnxDetector,
 )
+from seawatch.vision.external import CallableDetector, OnnxDetector
 from seawatch.vision.horizon import HorizonEstimate, HorizonTracker, detect_horizon, sea_mask
 from seawatch.vision.marks import (
     MARK_COLUMNS,
