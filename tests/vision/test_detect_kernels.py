@@ -1,4 +1,4 @@
-"""seawatch.vision.detect: the compiled (numba) kernels of the mask refinement against
+"""seawatch.vision.waterline: the compiled (numba) kernels of the water-line reading against
 plain numpy references.
 
 The references are the numpy forms the kernels replaced (kept here, verbatim but for
@@ -15,11 +15,11 @@ import math
 import numpy as np
 import pytest
 
-from seawatch.vision.detect import (
+from seawatch.vision.detect import _mad
+from seawatch.vision.waterline import (
     _column_edges,
     _hull_contrast_kernel,
     _level_breaks_kernel,
-    _mad,
     _theil_sen,
 )
 
@@ -32,7 +32,7 @@ def _median3(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
 def _column_edges_ref(
     raw: np.ndarray, obj: np.ndarray, quantum: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The numpy form of :func:`seawatch.vision.detect._column_edges`."""
+    """The numpy form of :func:`seawatch.vision.waterline._column_edges`."""
     H = obj.shape[0]
     cols = np.flatnonzero(obj.any(axis=0))
     bottom = H - 1 - np.argmax(obj[::-1, cols], axis=0)
@@ -78,7 +78,7 @@ def _column_edges_ref(
 
 
 def _theil_sen_ref(x: np.ndarray, y: np.ndarray, u: float) -> tuple[float, float, float]:
-    """The numpy form of :func:`seawatch.vision.detect._theil_sen`."""
+    """The numpy form of :func:`seawatch.vision.waterline._theil_sen`."""
     n = x.size
     if n < 2:
         return float(y[0]), 0.0, 0.0
@@ -178,7 +178,7 @@ def test_theil_sen_kernel_equals_numpy():
 
 
 def _hull_contrast_ref(rgb: np.ndarray, cols: np.ndarray, bottom: np.ndarray):
-    """The numpy form of the hull/sea levels in :func:`seawatch.vision.detect._frame_ships`."""
+    """The numpy form of the hull/sea levels in :func:`seawatch.vision.waterline._frame_ships`."""
     last = rgb.shape[0] - 1
     pick = [rgb[np.clip(bottom + k, 0, last), cols] for k in (-3, -2, -2, 3, 4, 5)]
     sea = _median3(*pick[3:])
@@ -188,7 +188,7 @@ def _hull_contrast_ref(rgb: np.ndarray, cols: np.ndarray, bottom: np.ndarray):
 
 
 def _level_breaks_ref(c: np.ndarray, e: np.ndarray, jump: float):
-    """The numpy form of the breaks of :func:`seawatch.vision.detect._waterline_levels`."""
+    """The numpy form of the breaks of :func:`seawatch.vision.waterline._waterline_levels`."""
     n = e.size
     em = e.copy()
     em[1:-1] = _median3(e[:-2], e[1:-1], e[2:])

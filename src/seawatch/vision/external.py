@@ -26,14 +26,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from seawatch._validation import FloatArray, in_range
-from seawatch.vision.detect import (
-    Detections,
-    _gray,
-    _horizon_ends,
-    _in_sea,
-    _sea_mask,
-    waterline_points,
-)
+from seawatch.vision.detect import Detections, _horizon_ends, _in_sea, _sea_mask
+from seawatch.vision.planes import _gray
+from seawatch.vision.waterline import waterline_points
 
 __all__ = ["CallableDetector", "OnnxDetector", "decode_yolo"]
 
