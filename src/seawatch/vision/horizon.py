@@ -111,6 +111,7 @@ from seawatch.camera.horizon import HorizonLine, horizon_line
 from seawatch.camera.pinhole import PinholeCamera
 from seawatch.filters.kalman import KalmanFilter
 from seawatch.models.kinematic import constant_velocity
+from seawatch.vision.planes import image_array
 
 __all__ = [
     "HorizonEstimate",
@@ -942,19 +943,9 @@ class _Candidate:
 
 
 def _as_image(image: ArrayLike) -> np.ndarray:
-    arr = np.asarray(image)
-    if arr.dtype == np.bool_:
-        arr = arr.astype(np.uint8)
-    if arr.dtype.kind not in "uif":
-        raise ValueError(f"image: expected an integer or float image, got dtype {arr.dtype}")
-    if arr.ndim == 3 and arr.shape[2] == 1:
-        arr = arr[:, :, 0]
+    arr = image_array(image)
     if arr.ndim == 3 and arr.shape[2] == 4:
         arr = arr[:, :, :3]
-    if not (arr.ndim == 2 or (arr.ndim == 3 and arr.shape[2] == 3)):
-        raise ValueError(
-            f"image: expected a (H, W) grey or (H, W, 3|4) BGR(A) image, got shape {arr.shape}"
-        )
     H, W = arr.shape[:2]
     if H < 16 or W < 16:
         raise ValueError(f"image: too small for horizon detection ({W}x{H} px, need 16x16)")

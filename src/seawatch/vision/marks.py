@@ -44,6 +44,7 @@ from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from seawatch._validation import FloatArray, positive
+from seawatch.vision.planes import image_array
 
 __all__ = [
     "MARK_COLUMNS",
@@ -85,24 +86,14 @@ def grayscale(image: ArrayLike) -> NDArray:
         ValueError: naming ``image`` for other shapes, complex or object dtypes, an
             empty image, or NaN/inf pixels.
     """
-    arr = np.asarray(image)
-    if arr.dtype == np.bool_:
-        arr = arr.astype(np.uint8)
-    if arr.dtype.kind not in "uif":
-        raise ValueError(f"image: expected an integer or float image, got dtype {arr.dtype}")
-    if arr.ndim == 3 and arr.shape[2] == 1:
-        arr = arr[:, :, 0]
-    if arr.ndim == 3 and arr.shape[2] in (3, 4):
+    arr = image_array(image)
+    if arr.ndim == 3:
         if arr.dtype in (np.uint8, np.uint16, np.float32):
             code = cv2.COLOR_BGR2GRAY if arr.shape[2] == 3 else cv2.COLOR_BGRA2GRAY
             arr = cv2.cvtColor(np.ascontiguousarray(arr), code)
         else:
             b, g, r = (arr[:, :, i].astype(np.float64) for i in range(3))
             arr = 0.299 * r + 0.587 * g + 0.114 * b
-    if arr.ndim != 2:
-        raise ValueError(
-            f"image: expected a (H, W) grey or (H, W, 3|4) BGR(A) image, got shape {arr.shape}"
-        )
     if arr.size == 0:
         raise ValueError(f"image: empty image of shape {arr.shape}")
     if arr.dtype.kind == "f" and not math.isfinite(float(np.sum(arr, dtype=np.float64))):

@@ -1,6 +1,7 @@
-"""The frame a detector is given, as planes: validated, grey and colour (private helpers
-shared by :mod:`seawatch.vision.detect`, :mod:`seawatch.vision.waterline` and
-:mod:`seawatch.vision.external`).
+"""The frame a detector is given, as planes: validated, grey and colour (helpers shared by
+:mod:`seawatch.vision.detect`, :mod:`seawatch.vision.waterline`,
+:mod:`seawatch.vision.external`, :mod:`seawatch.vision.horizon` and
+:mod:`seawatch.vision.marks`).
 
 Colour frames are taken in OpenCV's BGR(A) order; grey frames may be 8-bit, 16-bit
 (thermal) or float, kept in their own units.
@@ -15,13 +16,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 
-def _image_planes(image: ArrayLike) -> tuple[NDArray | None, float, NDArray | None]:
-    """The validated frame: its grey channel (uint8, uint16 or float32; None for a colour
-    frame), its quantum [units] and the BGR colour frame (None for grey input).
+def image_array(image: ArrayLike) -> NDArray:
+    """``image`` as an array of a grey (H, W) or BGR(A) (H, W, 3|4) frame: a bool image
+    becomes 0/1 uint8, a (H, W, 1) one (H, W); other values kept as they are.
 
-    Raises ValueError naming ``image`` for a wrong shape or dtype, an empty or tiny frame,
-    or NaN pixels.
-    """
+    Raises ValueError naming ``image`` for a complex, object or other non-numeric dtype
+    or any other shape (the checks every image entry point of :mod:`seawatch.vision`
+    shares)."""
     arr = np.asarray(image)
     if arr.dtype == np.bool_:
         arr = arr.astype(np.uint8)
@@ -33,6 +34,17 @@ def _image_planes(image: ArrayLike) -> tuple[NDArray | None, float, NDArray | No
         raise ValueError(
             f"image: expected a (H, W) grey or (H, W, 3|4) BGR(A) image, got shape {arr.shape}"
         )
+    return arr
+
+
+def _image_planes(image: ArrayLike) -> tuple[NDArray | None, float, NDArray | None]:
+    """The validated frame: its grey channel (uint8, uint16 or float32; None for a colour
+    frame), its quantum [units] and the BGR colour frame (None for grey input).
+
+    Raises ValueError naming ``image`` for a wrong shape or dtype, an empty or tiny frame,
+    or NaN pixels.
+    """
+    arr = image_array(image)
     if arr.shape[0] < 8 or arr.shape[1] < 8:
         raise ValueError(f"image: expected at least 8×8 pixels, got shape {arr.shape[:2]}")
     quantum = 1.0
