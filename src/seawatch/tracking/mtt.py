@@ -643,10 +643,11 @@ class MultiTargetTracker:
         smaller = np.minimum(np.prod(ts, axis=1)[:, None], np.prod(ds, axis=1)[None])
         with np.errstate(invalid="ignore", divide="ignore"):
             ov = np.where(smaller > 0.0, inter / smaller, 0.0)
-        order = np.argsort(-ov, axis=None, kind="stable")
         if self.confirmed_first:  # pairs in the gate: most detections first, then overlap
             hits = np.where(ov >= self.overlap_gate, self._hits[free_t][:, None], -1)
             order = np.lexsort((-ov.ravel(), -hits.ravel()))
+        else:
+            order = np.argsort(-ov, axis=None, kind="stable")
         out_r, out_c = [], []
         for flat in order:
             i, j = divmod(int(flat), free_d.size)
