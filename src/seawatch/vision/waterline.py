@@ -68,6 +68,33 @@ def _median_f32(a):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
+def _sea_levels(g, cols, bottom):  # pragma: no cover - compiled
+    """Per column ``cols[j]`` of a float32 (H, W, C) crop whose lowest mask row is
+    ``bottom[j]``: the sea's level, the middle of rows ``b + 3 … b + 5`` (clipped to the
+    crop), (n, C); and every one of those rows' deviation from it, (3 n C,) — for the
+    sea's noise. Shared by the edge and hull-contrast kernels."""
+    H = g.shape[0]
+    nch = g.shape[2]
+    n = cols.size
+    level = np.empty((n, nch), np.float32)
+    dev = np.empty(3 * n * nch, np.float32)
+    k = 0
+    for j in range(n):
+        c = cols[j]
+        b = bottom[j]
+        r3, r4, r5 = min(b + 3, H - 1), min(b + 4, H - 1), min(b + 5, H - 1)
+        for ch in range(nch):
+            s0, s1, s2 = g[r3, c, ch], g[r4, c, ch], g[r5, c, ch]
+            m = _mid3(s0, s1, s2)
+            level[j, ch] = m
+            dev[k] = abs(s0 - m)
+            dev[k + 1] = abs(s1 - m)
+            dev[k + 2] = abs(s2 - m)
+            k += 3
+    return level, dev
+
+
+@njit(cache=True, nogil=True)
 def _column_edges_kernel(g, obj, quantum):  # pragma: no cover - compiled
     """:func:`_column_edges` on a float32 (H, W, C) crop ``g`` and its (H, W) mask.
 
@@ -109,21 +136,7 @@ def _column_edges_kernel(g, obj, quantum):  # pragma: no cover - compiled
         bottom[j] = b
         j += 1
     # sea level per column: the middle of rows b + 3 … b + 5; σ from all their deviations
-    i_s = np.empty((n, nch), np.float32)
-    dev = np.empty(3 * n * nch, np.float32)
-    k = 0
-    for j in range(n):
-        c = cols[j]
-        b = bottom[j]
-        r3, r4, r5 = min(b + 3, H - 1), min(b + 4, H - 1), min(b + 5, H - 1)
-        for ch in range(nch):
-            s0, s1, s2 = g[r3, c, ch], g[r4, c, ch], g[r5, c, ch]
-            m = _mid3(s0, s1, s2)
-            i_s[j, ch] = m
-            dev[k] = abs(s0 - m)
-            dev[k + 1] = abs(s1 - m)
-            dev[k + 2] = abs(s2 - m)
-            k += 3
+    i_s, dev = _sea_levels(g, cols, bottom)
     sigma = max(1.4826 * _median_f32(dev), quantum, 1e-6)
     weak_below = np.float32((4.0 * sigma) ** 2 * nch)
     i_h = np.empty(nch, np.float32)
@@ -442,23 +455,14 @@ def _hull_contrast_kernel(rgb, cols, bottom):  # pragma: no cover - compiled
     same float32 operations, so the same numbers."""
     H = rgb.shape[0]
     nch = rgb.shape[2]
-    n = cols.size
-    hull = np.empty((n, nch), np.float32)
-    dev = np.empty(3 * n * nch, np.float32)
-    k = 0
-    for j in range(n):
+    sea, dev = _sea_levels(rgb, cols, bottom)
+    hull = np.empty((cols.size, nch), np.float32)
+    for j in range(cols.size):
         c = cols[j]
         b = bottom[j]
         h3, h2 = min(max(b - 3, 0), H - 1), min(max(b - 2, 0), H - 1)
-        s3, s4, s5 = min(max(b + 3, 0), H - 1), min(max(b + 4, 0), H - 1), min(max(b + 5, 0), H - 1)
         for ch in range(nch):
-            a0, a1, a2 = rgb[s3, c, ch], rgb[s4, c, ch], rgb[s5, c, ch]
-            sea = _mid3(a0, a1, a2)
-            hull[j, ch] = _mid3(rgb[h3, c, ch], rgb[h2, c, ch], rgb[h2, c, ch]) - sea
-            dev[k] = abs(a0 - sea)
-            dev[k + 1] = abs(a1 - sea)
-            dev[k + 2] = abs(a2 - sea)
-            k += 3
+            hull[j, ch] = _mid3(rgb[h3, c, ch], rgb[h2, c, ch], rgb[h2, c, ch]) - sea[j, ch]
     return hull, 1.4826 * _median_f32(dev)
 
 
