@@ -47,7 +47,6 @@ import numpy as np
 from seawatch.camera.horizon import attitude_from_horizon
 from seawatch.camera.pinhole import PinholeCamera
 from seawatch.geometry.geodesy import north_east_to_geodetic
-from seawatch.io.prefetch import prefetch
 from seawatch.io.track_table import TableWriter
 from seawatch.io.video import VideoReader
 from seawatch.tracking.world import ESTIMATORS, PlatformPose, WorldEstimates, WorldTracker
@@ -516,13 +515,12 @@ def track_video(
     labels: dict[int, int | None] = {}
     live_ids: set[int] = set()
     interrupted = False
-    # decode and horizon of the next frames run ahead in a thread (:mod:`seawatch.io.
-    # prefetch`) while this one is detected, tracked and written
-    frames_ahead = prefetch(reader, work=lambda f: (f, vtracker.horizon(f.image, f.time)))
+    # the next frames are decoded in one thread and their horizons and ships found in
+    # another (VisualTracker.stream) while this one is tracked and written
+    frames_ahead = vtracker.stream(reader)
     try:
-        for frame, hz in frames_ahead:
-            rows = vtracker.update(vtracker.detect(frame.image, frame.time, horizon=hz))
-            horizon = vtracker.last_horizon
+        for frame, horizon, detections in frames_ahead:
+            rows = vtracker.update(detections)
             t = float(frame.time)
             k = rows.shape[0]
             tids = rows[:, 0].astype(np.int64)

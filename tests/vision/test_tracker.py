@@ -67,7 +67,71 @@ def rendered(tmp_path_factory):
     for name in ("large", "meeting"):
         res = render_case(name, tmp_path_factory.mktemp(name), duration=3.0, width=960, height=540)
         out[name] = (detect_video(res.video), read_truth(res.truth))
+        out[f"{name}-video"] = res.video
     return out
+
+
+def test_stream_ahead_gives_the_sequential_results(rendered):
+    """Decoding, horizon and detection in background threads change nothing: the same
+    horizons, detections and tracks, frame by frame, as the step-by-step loop."""
+    from seawatch.io.video import VideoReader
+
+    seq, ahead = VisualTracker(), VisualTracker()
+    with VideoReader(rendered["meeting-video"]) as reader:
+        frames = list(reader)
+    assert len(frames) == 75
+    got = list(ahead.stream(frames))
+    assert [fr.index for fr, _, _ in got] == [fr.index for fr in frames]
+    for fr, hz, det in got:
+        want = seq.step(fr.image, fr.time)
+        assert (hz.found, hz.rho, hz.theta) == (
+            seq.last_horizon.found, seq.last_horizon.rho, seq.last_horizon.theta
+        )  # fmt: skip
+        np.testing.assert_array_equal(ahead.update(det), want)
+    a = VisualTracker().track_frames(frames)
+    b = VisualTracker().track_frames(frames, ahead=False)
+    assert len(a) == len(b) == 75 and sum(r.shape[0] for r in a) > 75
+    for x, y in zip(a, b, strict=True):
+        np.testing.assert_array_equal(x, y)
+
+
+def test_stream_stops_its_threads_and_closes_the_source_when_left_early():
+    import threading
+
+    closed = []
+
+    def frames():
+        try:
+            for k in range(1000):
+                yield np.full((60, 80), 40 + k % 3, np.uint8)
+        finally:
+            closed.append(True)
+
+    before = threading.active_count()
+    stream = VisualTracker(horizon=False).stream(frames())
+    for k, _ in enumerate(stream):
+        if k == 3:
+            break
+    stream.close()
+    for t in threading.enumerate():
+        if t.name == "seawatch-prefetch":
+            t.join(timeout=5)
+    assert closed == [True]
+    assert threading.active_count() == before
+
+
+def test_stream_raises_a_detector_error_at_its_frame_after_the_frames_before():
+    def detector(image, **_):
+        if image[0, 0] == 3:
+            raise RuntimeError("detector failed on frame 3")
+        return np.zeros((0, 4))
+
+    images = [np.full((60, 80), k, np.uint8) for k in range(6)]
+    seen = []
+    with pytest.raises(RuntimeError, match="frame 3"):
+        for fr, _, _ in VisualTracker(detector=detector, horizon=False).stream(images):
+            seen.append(int(fr[0, 0]))
+    assert seen == [0, 1, 2]
 
 
 def test_rendered_large_ship_cle_below_2_percent_of_diagonal(rendered):

@@ -65,7 +65,7 @@ def detect_video(video: str | Path, tracker: VisualTracker | None = None) -> lis
     vt = tracker if tracker is not None else VisualTracker()
     vt.reset()
     with VideoReader(video) as reader:
-        return [vt.detect(fr.image, fr.time) for fr in reader]
+        return [det for _, _, det in vt.stream(reader)]
 
 
 def track_case(

@@ -30,12 +30,7 @@ Colour frames are taken in OpenCV's BGR(A) order; grey frames may be 8-bit, 16-b
 
 from __future__ import annotations
 
-import functools
-import itertools
 import math
-import os
-from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any, Literal, Protocol, runtime_checkable
 
@@ -478,42 +473,6 @@ def _percentile(a: NDArray, q: float) -> float:
     if t >= 0.5:
         return float(y - d * np.float32(1.0 - t))
     return float(x + d * np.float32(t))
-
-
-def _threads() -> int:
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-
-
-@functools.cache
-def _pool() -> ThreadPoolExecutor:
-    return ThreadPoolExecutor(max_workers=_threads(), thread_name_prefix="seawatch-detect")
-
-
-def _run_rows(
-    kernel: Callable[..., None], rows: int, head: tuple[Any, ...], tail: tuple[Any, ...]
-) -> None:
-    """Run a row-range kernel ``kernel(*head, r0, r1, *tail)`` over ``rows`` rows.
-
-    A large image is cut into a few bands per core that the calling thread and the pool's
-    threads take in turn (the kernels release the GIL): on a busy machine a thread that
-    loses its core holds up one small band, not half of the image.
-    """
-    workers = _threads()
-    bands = max(1, min(4 * workers, rows // 48))
-    if bands == 1 or workers == 1:
-        kernel(*head, 0, rows, *tail)
-        return
-    edges = np.linspace(0, rows, bands + 1).astype(int).tolist()
-    ticket = itertools.count()  # next() is atomic under the GIL
-
-    def work() -> None:
-        while (i := next(ticket)) < bands:
-            kernel(*head, edges[i], edges[i + 1], *tail)
-
-    jobs = [_pool().submit(work) for _ in range(min(workers, bands) - 1)]
-    work()
-    for j in jobs:
-        j.result()
 
 
 @njit(cache=True, nogil=True)
@@ -1043,10 +1002,10 @@ class ClassicalShipDetector:
         starts[-1] = shift.size, 0
         if half:
             out = self._buffer(f"shear-{name}", (rows // 2, shift.size // 2))
-            _run_rows(_shear_half_kernel, rows // 2, (src, starts, fy), (out,))
+            _shear_half_kernel(src, starts, fy, 0, rows // 2, out)
         else:
             out = self._buffer(f"shear-{name}", (rows, shift.size))
-            _run_rows(_shear_kernel, rows, (src, starts, fy), (out,))
+            _shear_kernel(src, starts, fy, 0, rows, out)
         return out
 
     # ------------------------------------------------------------------ steps
@@ -1092,7 +1051,7 @@ class ClassicalShipDetector:
         )
         b5 = cv2.blur(gs, (5, 5), dst=self._buffer(f"b{tag}", shape))
         hi, lo, d, c, tex = (self._buffer(f"{n}{tag}", shape) for n in ("hi", "lo", "d", "c", "t"))
-        _run_rows(_contrast_kernel, shape[0], (gs, b5), (guard, flank, pol, hi, lo, d, c, tex))
+        _contrast_kernel(gs, b5, 0, shape[0], guard, flank, pol, hi, lo, d, c, tex)
         if factor == 1:
             base = _cell_noise(d, self.cell[0], self.cell[1], floor, step=2)
         else:  # coarser scales: cells of a quarter of the width, every pixel

@@ -276,7 +276,7 @@ _REGION_MIN = 0.03  # [feature-spread units] least region score of a sea horizon
 _CONTRAST_MIN = 0.5  # [σ_g] least median edge strength along a sea horizon
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True, nogil=True, fastmath=True)
 def _hough(P: np.ndarray, xs: np.ndarray, xc: float, slopes: np.ndarray, m: float) -> np.ndarray:
     """Hough accumulators E[k, i, c] for the two gradient polarities k = (+, −) (step 2).
 
@@ -318,7 +318,7 @@ def _hough(P: np.ndarray, xs: np.ndarray, xc: float, slopes: np.ndarray, m: floa
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _refine(
     gy: np.ndarray,
     P: np.ndarray,
@@ -466,7 +466,7 @@ def _refine(
     return c, t, q / w, n_in / w, contrast, True
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _region(
     cum: np.ndarray, c: float, t: float, xs: np.ndarray, xc: float, band: int, gap: int
 ) -> float:
@@ -517,7 +517,7 @@ _LUMA_GREY = np.array([1.0])
 _BGR2GREY = cv2.COLOR_BGR2GRAY
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _fine_profiles(
     img: np.ndarray, wts: np.ndarray, y0: float, t: float, R: int, bin_w: int, nb: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -570,7 +570,7 @@ def _fine_profiles(
     return prof, rbar, xbar, cnt
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _fine_peaks(prof: np.ndarray, pol: np.ndarray, R: int, S: int) -> tuple[np.ndarray, np.ndarray]:
     """Per bin: the row of the strongest central difference of the bin's polarity
     ``pol`` (+1 brighter below, −1 darker below, 0 either) within ±S rows of the profile
@@ -612,7 +612,7 @@ def _fine_peaks(prof: np.ndarray, pol: np.ndarray, R: int, S: int) -> tuple[np.n
     return peak, width
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _fine_edges(
     prof: np.ndarray, peak: np.ndarray, pol: np.ndarray, g: int, m: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -670,7 +670,7 @@ def _fine_edges(
     return e_out, d_out, noise
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _tukey_score(
     x: np.ndarray, y: np.ndarray, w: np.ndarray, c: float, t: float, cut: float
 ) -> float:
@@ -683,7 +683,7 @@ def _tukey_score(
     return sc
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _robust_line(
     x: np.ndarray,
     y: np.ndarray,
@@ -771,7 +771,7 @@ def _robust_line(
     return c, t, inl
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _strip_polarity(
     P: np.ndarray, x: np.ndarray, sx: float, sw: float, c: float, t: float
 ) -> np.ndarray:
@@ -793,7 +793,7 @@ def _strip_polarity(
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _fine_fit(
     prof: np.ndarray,
     rbar: np.ndarray,

@@ -28,7 +28,7 @@ px, px, px, px, frames]; ``x, y`` is the box's top-left corner.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from typing import Any, Literal
 
 import numpy as np
@@ -209,6 +209,9 @@ class VisualTracker:
         here)."""
         hz = self.horizon(image, time) if horizon is _FIND else horizon
         self.last_horizon = hz
+        return self._detect(image, hz)
+
+    def _detect(self, image: ArrayLike, hz: Any) -> FloatArray:
         try:
             det = self.detector(image, horizon=hz)
         except TypeError:
@@ -235,20 +238,58 @@ class VisualTracker:
         """Detect and track one frame; the confirmed tracks (:meth:`update`)."""
         return self.update(self.detect(image, time))
 
-    def track_frames(self, frames: Iterable[Any]) -> list[FloatArray]:
-        """Per-frame confirmed tracks of a frame sequence.
+    def stream(
+        self, frames: Iterable[Any], *, ahead: bool = True
+    ) -> Iterator[tuple[Any, Any, FloatArray]]:
+        """``(frame, horizon, detections)`` of each frame, in order (step 1: the
+        :meth:`horizon` and :meth:`detect` of each frame; hand the detections to
+        :meth:`update`).
+
+        With ``ahead`` the frames are read and their horizons found in one background
+        thread and their ships detected in another, a few frames ahead of the caller
+        (:func:`seawatch.io.prefetch.prefetch`): decoding, detection and the caller's
+        tracking of earlier frames overlap on two cores (the decoder, OpenCV and the
+        compiled kernels release the GIL). The results are those of the sequential
+        loop: each stage keeps the frame order, and the horizon tracker and the
+        detector see the frames one at a time. Stopping the iteration early stops both
+        threads and closes ``frames``.
 
         Args:
             frames: images (H, W[, C]) or :class:`seawatch.io.video.Frame` objects (their
                 ``time`` feeds the horizon tracker), e.g. a ``VideoReader``.
+            ahead: False: everything in the calling thread.
+        """
+
+        def horizon(fr: Any) -> tuple[Any, Any]:
+            return fr, self.horizon(getattr(fr, "image", fr), getattr(fr, "time", None))
+
+        def detect(item: tuple[Any, Any]) -> tuple[Any, Any, FloatArray]:
+            fr, hz = item
+            return fr, hz, self._detect(getattr(fr, "image", fr), hz)
+
+        if not ahead:
+            yield from map(detect, map(horizon, frames))
+            return
+        from seawatch.io.prefetch import prefetch
+
+        yield from prefetch(prefetch(frames, work=horizon), work=detect)
+
+    def track_frames(self, frames: Iterable[Any], *, ahead: bool = True) -> list[FloatArray]:
+        """Per-frame confirmed tracks of a frame sequence (:meth:`stream` →
+        :meth:`update`).
+
+        Args:
+            frames: images (H, W[, C]) or :class:`seawatch.io.video.Frame` objects (their
+                ``time`` feeds the horizon tracker), e.g. a ``VideoReader``.
+            ahead: detect ahead in background threads (:meth:`stream`).
 
         Returns:
             one (n_k, 8) array of :data:`TRACK_COLUMNS` per frame.
         """
         out = []
-        for fr in frames:
-            image = getattr(fr, "image", fr)
-            out.append(self.step(image, getattr(fr, "time", None)))
+        for _, hz, det in self.stream(frames, ahead=ahead):
+            self.last_horizon = hz
+            out.append(self.update(det))
         return out
 
     def track_detections(self, detections: Sequence[Any]) -> list[FloatArray]:
