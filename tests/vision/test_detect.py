@@ -290,6 +290,27 @@ def test_random_scenes_recall_and_false_boxes_per_frame(refine):
     assert false / n <= 0.5
 
 
+def test_frames_prepared_ahead_give_the_detections_of_whole_calls():
+    """prepare() may run frames ahead of detect_prepared() (VisualTracker.stream): three
+    rolled colour scenes prepared first, then detected, equal three whole calls."""
+    rng = np.random.default_rng(99)
+    frames = []
+    for roll in (-2.0, 0.0, 2.5):
+        img, _, line = sea_scene(rng, roll_deg=roll, ships=fixed_ships(), coast=True)
+        grey = as_u8(img)
+        frames.append((np.dstack([grey, np.roll(grey, 1, axis=1), grey]), line))
+    det = ClassicalShipDetector()
+    want = [det(img, horizon=line).boxes for img, line in frames]
+    assert all(w.shape[0] >= 4 for w in want)
+    ready = [det.prepare(img, horizon=line) for img, line in frames]
+    for r, w in zip(ready, want, strict=True):
+        np.testing.assert_array_equal(det.detect_prepared(r).boxes, w)
+    # no sea in view: an empty prepared frame gives no detections
+    img, line = frames[0]
+    none = det.prepare(img, sea_mask=np.zeros(img.shape[:2], bool))
+    assert none.frame is None and len(det.detect_prepared(none)) == 0
+
+
 @pytest.mark.parametrize("refine", REFINE)
 def test_glitter_patch_and_coastline_give_no_boxes(refine):
     rng = np.random.default_rng(7)

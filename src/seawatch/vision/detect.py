@@ -49,6 +49,7 @@ __all__ = [
     "ClassicalShipDetector",
     "Detections",
     "Detector",
+    "PreparedFrame",
     "sea_region",
     "waterline_points",
 ]
@@ -592,6 +593,21 @@ def _overlap(a: NDArray, b: NDArray) -> bool:
     return bool(a[0] <= b[2] and b[0] <= a[2] and a[1] <= b[3] and b[1] <= a[3])
 
 
+@dataclass(frozen=True)
+class PreparedFrame:
+    """A frame made ready for detection (:meth:`ClassicalShipDetector.prepare`).
+
+    Attributes:
+        frame: the working band and geometry; None when no sea is in view.
+        sea_mask: the (H, W) sea mask given, or None.
+        ends: the horizon's rows at the left and right borders [px], or None.
+    """
+
+    frame: _Frame | None
+    sea_mask: NDArray[np.bool_] | None
+    ends: tuple[float, float] | None
+
+
 @dataclass
 class _Level:
     """Contrast maps of one scale: level pixel (i, j) covers working pixels
@@ -874,6 +890,19 @@ class ClassicalShipDetector:
         Raises:
             ValueError: naming ``image``, ``sea_mask`` or ``horizon`` for bad input.
         """
+        return self.detect_prepared(self.prepare(image, sea_mask=sea_mask, horizon=horizon))
+
+    def prepare(
+        self, image: ArrayLike, *, sea_mask: ArrayLike | None = None, horizon: Any = None
+    ) -> PreparedFrame:
+        """The first step of :meth:`__call__` alone: the frame's working band (and chroma
+        planes), for :meth:`detect_prepared`. It keeps no state and writes into fresh
+        arrays, so it may run in another thread, frames ahead of the detection (as
+        :meth:`~seawatch.vision.tracker.VisualTracker.stream` does).
+
+        Raises:
+            ValueError: naming ``image``, ``sea_mask`` or ``horizon`` for bad input.
+        """
         grey, quantum, colour = _image_planes(image)
         if colour is not None and not self.colour:
             grey, colour = cv2.cvtColor(colour, cv2.COLOR_BGR2GRAY), None
@@ -881,15 +910,22 @@ class ClassicalShipDetector:
         mask = _sea_mask(sea_mask, (H, W))
         ends = _horizon_ends(horizon, W)
         if mask is not None and not mask.any():
-            return Detections.empty()
-        fr = self._frame(grey, colour, mask, ends, quantum)
+            return PreparedFrame(None, mask, ends)
+        return PreparedFrame(self._frame(grey, colour, mask, ends, quantum), mask, ends)
+
+    def detect_prepared(self, prepared: PreparedFrame) -> Detections:
+        """The detections of a frame :meth:`prepare` d (the remaining steps of
+        :meth:`__call__`; frames in video order when ``temporal``)."""
+        fr, mask, ends = prepared.frame, prepared.sea_mask, prepared.ends
         if fr is None:
             return Detections.empty()
+        H, W = fr.shape
         band = fr.band
         bmin, bmax = cv2.minMaxLoc(band)[:2]
         if bmin == bmax:
             return Detections.empty()  # a constant frame holds nothing
-        floor = max(0.5 * quantum / math.sqrt(max(1.0, fr.sx * fr.sy)), 1e-4 * (bmax - bmin), 1e-12)
+        quantum_floor = 0.5 * fr.quantum / math.sqrt(max(1.0, fr.sx * fr.sy))
+        floor = max(quantum_floor, 1e-4 * (bmax - bmin), 1e-12)
         levels = self._levels(band, floor, fr)
         cands = self._candidates(levels, band.shape)
         if not cands:
@@ -967,7 +1003,7 @@ class ClassicalShipDetector:
         if off is None:
             band = work[wtop:].astype(np.float32)
         else:  # working row r of column c is read at r + off[c]: the horizon is one row
-            band = self._shear(work, wtop + off, wh - wtop, "band")
+            band = self._shear(work, wtop + off, wh - wtop)
         chroma = []
         if cwork is not None and ww >= 2 and wh - wtop >= 2:
             # Cr, Cb of the working frame, sheared like the band, at half its resolution:
@@ -976,7 +1012,7 @@ class ClassicalShipDetector:
             shift = np.full(ww, wtop, np.float32) if off is None else wtop + off
             for ch_index in (1, 2):
                 p = cv2.extractChannel(ycc, ch_index)  # contiguous rows shear faster
-                half = self._shear(p, shift, wh - wtop, f"chroma{ch_index}", half=True)
+                half = self._shear(p, shift, wh - wtop, half=True)
                 lo_c, hi_c = cv2.minMaxLoc(np.ascontiguousarray(half[::2, ::2]))[:2]
                 if hi_c - lo_c < 2.0 * max(quantum, 1e-6 * max(abs(hi_c), 1.0)):
                     continue  # a flat chroma plane (a grey frame stored as colour)
@@ -984,9 +1020,8 @@ class ClassicalShipDetector:
         hrow = top - wtop if ends is not None or mask is not None else 0.0
         return _Frame((H, W), grey, band, wtop, sx, sy, off, hrow, colour, chroma, quantum)
 
-    def _shear(
-        self, src: NDArray, shift: NDArray, rows: int, name: str, half: bool = False
-    ) -> NDArray:
+    @staticmethod
+    def _shear(src: NDArray, shift: NDArray, rows: int, half: bool = False) -> NDArray:
         """``rows`` rows of ``src`` (float32), column ``c`` read from row ``i + shift[c]``
         (linear between rows, edge rows repeated): a per-column vertical shift [px].
         ``half``: the result's 2 × 2 means instead (``rows // 2`` rows, half the
@@ -1000,11 +1035,11 @@ class ClassicalShipDetector:
         starts[1:-1, 0] = cut
         starts[1:-1, 1] = iy[cut]
         starts[-1] = shift.size, 0
-        if half:
-            out = self._buffer(f"shear-{name}", (rows // 2, shift.size // 2))
+        if half:  # fresh arrays: prepare() may run ahead of the detection
+            out = np.empty((rows // 2, shift.size // 2), np.float32)
             _shear_half_kernel(src, starts, fy, 0, rows // 2, out)
         else:
-            out = self._buffer(f"shear-{name}", (rows, shift.size))
+            out = np.empty((rows, shift.size), np.float32)
             _shear_kernel(src, starts, fy, 0, rows, out)
         return out
 

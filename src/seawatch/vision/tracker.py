@@ -245,8 +245,10 @@ class VisualTracker:
         :meth:`horizon` and :meth:`detect` of each frame; hand the detections to
         :meth:`update`).
 
-        With ``ahead`` the frames are read and their horizons found in one background
-        thread and their ships detected in another, a few frames ahead of the caller
+        With ``ahead`` the frames are read and their horizons found (and, with a detector
+        that has ``prepare``/``detect_prepared`` such as the classical one, their working
+        bands made) in one background thread and their ships detected in another, a few
+        frames ahead of the caller
         (:func:`seawatch.io.prefetch.prefetch`): decoding, detection and the caller's
         tracking of earlier frames overlap on two cores (the decoder, OpenCV and the
         compiled kernels release the GIL). The results are those of the sequential
@@ -260,11 +262,21 @@ class VisualTracker:
             ahead: False: everything in the calling thread.
         """
 
-        def horizon(fr: Any) -> tuple[Any, Any]:
-            return fr, self.horizon(getattr(fr, "image", fr), getattr(fr, "time", None))
+        prepare = getattr(self.detector, "prepare", None)
+        finish = getattr(self.detector, "detect_prepared", None)
+        split = callable(prepare) and callable(finish)
 
-        def detect(item: tuple[Any, Any]) -> tuple[Any, Any, FloatArray]:
-            fr, hz = item
+        def horizon(fr: Any) -> tuple[Any, Any, Any]:
+            image = getattr(fr, "image", fr)
+            hz = self.horizon(image, getattr(fr, "time", None))
+            # a detector that can prepare a frame apart (the classical one: its working
+            # band) does so here, which balances the two threads
+            return fr, hz, prepare(image, horizon=hz) if split else None  # type: ignore[misc]
+
+        def detect(item: tuple[Any, Any, Any]) -> tuple[Any, Any, FloatArray]:
+            fr, hz, ready = item
+            if split:
+                return fr, hz, _detection_rows(finish(ready))  # type: ignore[misc]
             return fr, hz, self._detect(getattr(fr, "image", fr), hz)
 
         if not ahead:
