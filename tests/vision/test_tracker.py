@@ -107,12 +107,16 @@ def test_stream_stops_its_threads_and_closes_the_source_when_left_early():
         finally:
             closed.append(True)
 
-    before = threading.active_count()
+    import cv2
+
+    before, cv_threads = threading.active_count(), cv2.getNumThreads()
     stream = VisualTracker(horizon=False).stream(frames())
     for k, _ in enumerate(stream):
+        assert cv2.getNumThreads() == 1  # OpenCV's pool off while the stream runs
         if k == 3:
             break
     stream.close()
+    assert cv2.getNumThreads() == cv_threads
     for t in threading.enumerate():
         if t.name == "seawatch-prefetch":
             t.join(timeout=5)
