@@ -17,14 +17,17 @@ def test_rows_appear_only_at_flush_and_cells_round_trip(tmp_path):
     assert path.read_bytes() == b"a,b,c,d\r\n"  # the header is on disk at once
     w.write({"a": np.int64(3), "b": 50.79031234567, "c": math.nan, "e": "ignored"})
     w.write({"a": 4, "b": -1.5e-9, "c": None, "d": "x,y"})
+    # Python and numpy floats alike: 10 significant digits, non-finite values empty
+    w.write({"a": True, "b": np.float64(2.0) / 3, "c": -math.inf, "d": np.float32(0.25)})
     assert path.read_bytes() == b"a,b,c,d\r\n"  # nothing before the flush
     w.flush()
     rows = read_table(path)
     assert rows == [
         {"a": "3", "b": "50.79031235", "c": "", "d": ""},
         {"a": "4", "b": "-1.5e-09", "c": "", "d": "x,y"},
+        {"a": "1", "b": "0.6666666667", "c": "", "d": "0.25"},
     ]
-    assert w.close() == [path] and w.rows == 2
+    assert w.close() == [path] and w.rows == 3
 
 
 def test_bad_tables_name_the_file(tmp_path):

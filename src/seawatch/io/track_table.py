@@ -26,6 +26,8 @@ __all__ = ["TableWriter", "read_table"]
 
 
 def _cell(value: Any) -> str:
+    if type(value) is float:  # the common case first (a track job writes ~100k cells)
+        return f"{value:.10g}" if math.isfinite(value) else ""
     if value is None:
         return ""
     if isinstance(value, str):
