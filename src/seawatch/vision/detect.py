@@ -914,8 +914,8 @@ class ClassicalShipDetector:
         return PreparedFrame(self._frame(grey, colour, mask, ends, quantum), mask, ends)
 
     def detect_prepared(self, prepared: PreparedFrame) -> Detections:
-        """The detections of a frame :meth:`prepare` d (the remaining steps of
-        :meth:`__call__`; frames in video order when ``temporal``)."""
+        """The detections of a frame made ready by :meth:`prepare` (the remaining steps
+        of :meth:`__call__`; give the frames in video order when ``temporal``)."""
         fr, mask, ends = prepared.frame, prepared.sea_mask, prepared.ends
         if fr is None:
             return Detections.empty()
