@@ -8,6 +8,7 @@ closed forms (perfect tracks score perfectly; a known shift gives that CLE).
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 import pytest
@@ -48,6 +49,21 @@ def test_tiny_run_returns_the_benchmark_json_with_positive_speeds(tiny):
     assert st["image_stage_overlapped"] + st["pipeline"] == pytest.approx(ms["track_video"])
     for r in doc["results"]:  # Linux: the hypervisor's share during the run, a percentage
         assert r["steal_percent"] is None or 0.0 <= r["steal_percent"] <= 100.0
+    # the CPU time per thread: the track job's three named threads; together at most the
+    # process's CPU time (a thread ending between two samples loses its last bit)
+    by_name = {r["name"]: r for r in doc["results"]}
+    if sys.platform.startswith("linux"):
+        for k in ("decode+horizon+detect+track", "track_video"):
+            t = by_name[k]["thread_cpu_ms_per_frame"]
+            assert {"MainThread", "seawatch-read", "seawatch-detect"} <= set(t), t
+            assert all(v > 0 for v in t.values())
+            total = 1000.0 / by_name[k]["cpu_time_frames_per_s"]
+            assert sum(t.values()) <= 1.05 * total + 1.0
+        # decoding alone runs in the calling thread (and the decoder's own threads)
+        assert "MainThread" in by_name["decode"]["thread_cpu_ms_per_frame"]
+        assert not {"seawatch-read", "seawatch-detect"} & set(
+            by_name["decode"]["thread_cpu_ms_per_frame"]
+        )
     for k in ("track_video", "decode+horizon+detect+track"):
         t = doc["targets"][k]
         assert t["target"] == video.SPEED_TARGET and t["met"] == (t["measured"] >= 25.0)

@@ -113,12 +113,13 @@ def test_stream_stops_its_threads_and_closes_the_source_when_left_early():
     stream = VisualTracker(horizon=False).stream(frames())
     for k, _ in enumerate(stream):
         assert cv2.getNumThreads() == 1  # OpenCV's pool off while the stream runs
+        assert {"seawatch-read", "seawatch-detect"} <= {t.name for t in threading.enumerate()}
         if k == 3:
             break
     stream.close()
     assert cv2.getNumThreads() == cv_threads
     for t in threading.enumerate():
-        if t.name == "seawatch-prefetch":
+        if t.name in ("seawatch-read", "seawatch-detect"):
             t.join(timeout=5)
     assert closed == [True]
     assert threading.active_count() == before

@@ -26,10 +26,13 @@ are the per-frame costs of decoding, the horizon and detection; the last two ove
 those stages on the machine's cores, and ``pipeline`` is what the track job adds to its
 image stage. Speeds are frames per second of wall-clock time, with their ratios to
 decode alone in the same run. Each result also gives the rate in process CPU time
-(every thread of the process) and, where ``/proc/stat`` tells it (Linux), the share of
-the machine's CPU time the hypervisor gave to other guests during the run (``steal``):
+(every thread of the process), and, where ``/proc`` tells them (Linux), the share of
+the machine's CPU time the hypervisor gave to other guests during the run (``steal``:
 on a shared virtual machine the wall-clock rates fall with it while the code is the
-same. Targets (issues 6 and 7): ``track_video`` ≥ 25 frames/s and
+same) and the CPU time per frame of each thread by name (the track job's
+``MainThread``, ``seawatch-read`` and ``seawatch-detect``, and the decoder's
+:data:`NATIVE_THREADS`): the busiest thread and the total over the cores bound the
+frame rate the machine could reach. Targets (issues 6 and 7): ``track_video`` ≥ 25 frames/s and
 ``decode+horizon+detect+track`` ≥ 25 frames/s.
 
 ``agreement`` — speed must not be bought with wrong answers: the ``tracks.csv`` of the
@@ -51,6 +54,7 @@ import inspect
 import math
 import os
 import tempfile
+import threading
 import time
 import warnings
 from collections.abc import Callable, Iterator
@@ -302,19 +306,83 @@ def _cpu_ticks() -> tuple[int, int] | None:
     return (ticks[7], sum(ticks)) if f[0] == "cpu" and len(ticks) == 8 else None
 
 
-def _timed(fn: Callable[[], int]) -> tuple[float, float, int, float | None]:
-    """Wall-clock and process CPU seconds of ``fn()``, the frames it reports and the
+NATIVE_THREADS = "native"
+"""Label of the process's threads that Python did not start (the video decoder's)."""
+
+
+def _task_cpu() -> dict[int, float]:
+    """CPU seconds so far of each thread of this process (``/proc/self/task``; empty
+    where there is none)."""
+    tick = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
+    out = {}
+    try:
+        tids = os.listdir("/proc/self/task")
+    except OSError:
+        return out
+    for tid in tids:
+        try:
+            with open(f"/proc/self/task/{tid}/stat", encoding="ascii") as fh:
+                stat = fh.read()
+        except OSError:  # the thread ended meanwhile
+            continue
+        f = stat[stat.rindex(")") + 2 :].split()
+        out[int(tid)] = (int(f[11]) + int(f[12])) / tick  # utime + stime
+    return out
+
+
+class _ThreadClock:
+    """CPU seconds per thread name of what runs between ``start`` and ``stop``: the
+    threads are sampled every 20 ms (a thread that ends between two samples loses its
+    last CPU time here, not in the process total) and named
+    by :mod:`threading` (others: :data:`NATIVE_THREADS`)."""
+
+    def __init__(self) -> None:
+        self._base = _task_cpu()
+        self._last: dict[int, float] = {}
+        self._names: dict[int, str] = {}
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="seawatch-bench-clock")
+        self._thread.start()
+
+    def _sample(self) -> None:
+        self._last.update(_task_cpu())
+        for t in threading.enumerate():
+            if t.native_id is not None:
+                self._names.setdefault(t.native_id, t.name)
+
+    def _run(self) -> None:
+        while not self._stop.wait(0.02):
+            self._sample()
+
+    def stop(self) -> dict[str, float]:
+        self._stop.set()
+        self._thread.join()
+        self._sample()
+        own = self._thread.native_id
+        out: dict[str, float] = {}
+        for tid, cpu in self._last.items():
+            if tid == own:
+                continue
+            name = self._names.get(tid, NATIVE_THREADS)
+            out[name] = out.get(name, 0.0) + cpu - self._base.get(tid, 0.0)
+        return {k: v for k, v in out.items() if v > 0.0}
+
+
+def _timed(fn: Callable[[], int]) -> tuple[float, float, int, float | None, dict[str, float]]:
+    """Wall-clock and process CPU seconds of ``fn()``, the frames it reports, the
     percentage of the machine's CPU time stolen by the hypervisor meanwhile (None where
-    unknown)."""
+    unknown) and the CPU seconds per thread name (empty where unknown)."""
     s0 = _cpu_ticks()
+    clock = _ThreadClock()
     t0, c0 = time.perf_counter(), time.process_time()
     n = fn()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    threads = clock.stop()
     s1 = _cpu_ticks()
     steal = None
     if s0 is not None and s1 is not None and s1[1] > s0[1]:
         steal = 100.0 * (s1[0] - s0[0]) / (s1[1] - s0[1])
-    return wall, cpu, n, steal
+    return wall, cpu, n, steal, threads
 
 
 # --------------------------------------------------------------------------------------
@@ -442,7 +510,7 @@ def run(
             "decode+horizon+detect+track": lambda: _stage(clip),
             "track_video": lambda: _track_video(clip, tmp_path / "out"),
         }
-        best: dict[str, tuple[float, float, int, float | None]] = {}
+        best: dict[str, tuple[float, float, int, float | None, dict[str, float]]] = {}
         for name in VARIANTS:
             say(name)
             for _ in range(repeats):
@@ -456,8 +524,8 @@ def run(
     stage = np.concatenate(stage_rows) if stage_rows else np.empty((0, 6))
     q = quality(table, truth)
     same, diff = _same_tracks(stage, table)
-    fps_of = {k: n / wall for k, (wall, _, n, _) in best.items()}
-    cpu_of = {k: (n / cpu if cpu > 0 else math.inf) for k, (_, cpu, n, _) in best.items()}
+    fps_of = {k: b[2] / b[0] for k, b in best.items()}
+    cpu_of = {k: (b[2] / b[1] if b[1] > 0 else math.inf) for k, b in best.items()}
     results = [
         {
             "name": k,
@@ -465,6 +533,9 @@ def run(
             "unit": "frames/s",
             "cpu_time_frames_per_s": cpu_of[k],
             "steal_percent": best[k][3],
+            "thread_cpu_ms_per_frame": {
+                name: 1000.0 * sec / max(best[k][2], 1) for name, sec in best[k][4].items()
+            },
             "frames": best[k][2],
         }
         for k in VARIANTS

@@ -51,6 +51,12 @@ height h [px], water-line point u_wl, v_wl [px], consecutive missed detections [
 
 _FIND = object()  # detect(): find the horizon of the frame
 
+READ_THREAD = "seawatch-read"
+"""Name of :meth:`VisualTracker.stream`'s thread that decodes, finds the horizon and
+prepares each frame."""
+DETECT_THREAD = "seawatch-detect"
+"""Name of :meth:`VisualTracker.stream`'s thread that detects the ships."""
+
 FilterName = Literal["afkf", "fkf", "kf"]
 FILTERS: tuple[str, ...] = ("afkf", "fkf", "kf")
 """The filters :class:`VisualTracker` offers (ship-video estimators of INTERFACES.md)."""
@@ -293,7 +299,8 @@ class VisualTracker:
         threads = cv2.getNumThreads()
         cv2.setNumThreads(1)
         try:
-            yield from prefetch(prefetch(frames, work=horizon), work=detect)
+            ready = prefetch(frames, work=horizon, name=READ_THREAD)
+            yield from prefetch(ready, work=detect, name=DETECT_THREAD)
         finally:
             cv2.setNumThreads(threads)
 
