@@ -238,9 +238,9 @@ def sea_region(shape: tuple[int, int], horizon: Any) -> NDArray[np.bool_]:
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def _contrast_kernel(  # pragma: no cover - compiled
-    gs, b5, r0, r1, guard, flank, polarity, hi, lo, d, c, tex
+    gs, b5, guard, flank, polarity, hi, lo, d, c, tex
 ):
-    """Greatest-of CFAR contrast and least-of clutter level, rows ``r0 … r1 − 1``.
+    """Greatest-of CFAR contrast and least-of clutter level of every pixel.
 
     ``gs`` is the smoothed plane and ``b5`` its 5 × 5 box mean; ``e² = (gs − b5)²`` is
     the squared local detail. Per pixel: ``L``/``R`` = mean of ``gs`` over the 3-row ×
@@ -263,7 +263,7 @@ def _contrast_kernel(  # pragma: no cover - compiled
     inv_n = 1.0 / (3.0 * flank)
     jl = guard + flank  # first column with a left window
     jr = W - guard - flank - 1  # last column with a right window
-    for r in range(r0, r1):
+    for r in range(H):
         g0 = gs[max(r - 1, 0)]
         g1 = gs[r]
         g2 = gs[min(r + 1, H - 1)]
@@ -430,21 +430,21 @@ def _shear_row(src, starts, fy, y, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _shear_kernel(src, starts, fy, r0, r1, out):  # pragma: no cover - compiled
-    """Rows ``r0 … r1 − 1`` of the sheared band: row ``i`` is :func:`_shear_row` at
+def _shear_kernel(src, starts, fy, out):  # pragma: no cover - compiled
+    """The sheared band (``out.shape[0]`` rows): row ``i`` is :func:`_shear_row` at
     ``y = i``."""
-    for i in range(r0, r1):
+    for i in range(out.shape[0]):
         _shear_row(src, starts, fy, i, out[i])
 
 
 @njit(cache=True, nogil=True)
-def _shear_half_kernel(src, starts, fy, r0, r1, out):  # pragma: no cover - compiled
-    """Rows ``r0 … r1 − 1`` of the sheared band at half resolution: ``out[i, j]`` is the
+def _shear_half_kernel(src, starts, fy, out):  # pragma: no cover - compiled
+    """The sheared band at half resolution (``out.shape[0]`` rows): ``out[i, j]`` is the
     mean of the sheared band (:func:`_shear_kernel`) over rows ``2i, 2i + 1`` and columns
     ``2j, 2j + 1``."""
     rows = np.empty((2, fy.shape[0]), np.float32)
     quarter = np.float32(0.25)
-    for i in range(r0, r1):
+    for i in range(out.shape[0]):
         _shear_row(src, starts, fy, 2 * i, rows[0])
         _shear_row(src, starts, fy, 2 * i + 1, rows[1])
         a = rows[0]
@@ -1037,10 +1037,10 @@ class ClassicalShipDetector:
         starts[-1] = shift.size, 0
         if half:  # fresh arrays: prepare() may run ahead of the detection
             out = np.empty((rows // 2, shift.size // 2), np.float32)
-            _shear_half_kernel(src, starts, fy, 0, rows // 2, out)
+            _shear_half_kernel(src, starts, fy, out)
         else:
             out = np.empty((rows, shift.size), np.float32)
-            _shear_kernel(src, starts, fy, 0, rows, out)
+            _shear_kernel(src, starts, fy, out)
         return out
 
     # ------------------------------------------------------------------ steps
@@ -1086,7 +1086,7 @@ class ClassicalShipDetector:
         )
         b5 = cv2.blur(gs, (5, 5), dst=self._buffer(f"b{tag}", shape))
         hi, lo, d, c, tex = (self._buffer(f"{n}{tag}", shape) for n in ("hi", "lo", "d", "c", "t"))
-        _contrast_kernel(gs, b5, 0, shape[0], guard, flank, pol, hi, lo, d, c, tex)
+        _contrast_kernel(gs, b5, guard, flank, pol, hi, lo, d, c, tex)
         if factor == 1:
             base = _cell_noise(d, self.cell[0], self.cell[1], floor, step=2)
         else:  # coarser scales: cells of a quarter of the width, every pixel
