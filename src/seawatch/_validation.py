@@ -154,5 +154,17 @@ def in_range(
     return v
 
 
+def int_pair(name: str, value: object, labels: tuple[str, str], minimum: int) -> tuple[int, int]:
+    """Two integers (e.g. a size in pixels) given as a pair, both >= *minimum*; *labels*
+    name the two in the error message (``("width", "height")``)."""
+    try:
+        a, b = (int(v) for v in value)  # type: ignore[attr-defined]
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected ({labels[0]}, {labels[1]}), got {value!r}") from None
+    if a < minimum or b < minimum:
+        raise ValueError(f"{name}: expected both sides >= {minimum} px, got {value!r}")
+    return a, b
+
+
 def _fmt(shape: tuple[int | None, ...]) -> str:
     return "(" + ", ".join("any" if s is None else str(s) for s in shape) + ")"

@@ -480,9 +480,13 @@ def test_bad_mask_horizon_and_options_raise_value_error_naming_them():
         ({"max_aspect": (0.5, 2)}, "max_aspect"),
         ({"temporal_rate": 0}, "temporal_rate"),
         ({"refine": "grabcut"}, "refine"),
+        ({"cell": 8}, r"cell: expected \(rows, cols\)"),
+        ({"cell": (8, 64, 2)}, r"cell: expected \(rows, cols\)"),
+        ({"cell": (8, 1)}, "cell: expected both sides >= 2 px"),
     ]:
         with pytest.raises(ValueError, match=name):
             ClassicalShipDetector(**kw)
+    assert ClassicalShipDetector(cell=(6.0, 40)).cell == (6, 40)
 
 
 # ------------------------------------------------------------------ water line, whole ships
@@ -817,6 +821,10 @@ def test_onnx_detector_needs_an_existing_model_and_says_how_to_get_onnxruntime(
         OnnxDetector(tmp_path / "missing.onnx")
     model = tmp_path / "m.onnx"
     model.write_bytes(b"not really a model")
+    with pytest.raises(ValueError, match=r"input_size: expected \(width, height\)"):
+        OnnxDetector(model, input_size="640")
+    with pytest.raises(ValueError, match="input_size: expected both sides >= 8 px"):
+        OnnxDetector(model, input_size=(640, 4))
     monkeypatch.setitem(sys.modules, "onnxruntime", None)  # as if not installed
     with pytest.raises(ImportError, match="pip install onnxruntime"):
         OnnxDetector(model)

@@ -40,7 +40,7 @@ from numba import njit
 from numpy.typing import ArrayLike, NDArray
 from scipy.special import ndtri as _ndtri
 
-from seawatch._validation import FloatArray, in_range, positive
+from seawatch._validation import FloatArray, in_range, int_pair, positive
 from seawatch.vision.planes import _image_planes
 from seawatch.vision.waterline import _frame_ships, _waterline, waterline_points
 
@@ -832,13 +832,7 @@ class ClassicalShipDetector:
         self.levels = _int("levels", levels, 1)
         self.guard = _int("guard", guard, 1)
         self.flank = _int("flank", flank, 2)
-        try:
-            ch, cw = (int(v) for v in cell)
-        except (TypeError, ValueError):
-            raise ValueError(f"cell: expected (rows, cols), got {cell!r}") from None
-        if ch < 2 or cw < 2:
-            raise ValueError(f"cell: expected both sides >= 2 px, got {cell!r}")
-        self.cell = (ch, cw)
+        self.cell = int_pair("cell", cell, ("rows", "cols"), 2)
         self.min_size = positive("min_size", min_size)
         self.min_area = positive("min_area", min_area, allow_zero=True)
         self.max_size = in_range("max_size", max_size, 0.0, 1.0, lo_open=True)

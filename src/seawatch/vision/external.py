@@ -25,7 +25,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from seawatch._validation import FloatArray, in_range
+from seawatch._validation import FloatArray, in_range, int_pair
 from seawatch.vision.detect import Detections, _horizon_ends, _in_sea, _sea_mask
 from seawatch.vision.planes import _gray
 from seawatch.vision.waterline import waterline_points
@@ -304,12 +304,7 @@ class OnnxDetector:
             raise FileNotFoundError(f"model_path: no such ONNX model file: {path}")
         if layout not in ("auto", "yolov8", "yolov5", "end2end"):
             raise ValueError(f"layout: expected auto, yolov8, yolov5 or end2end, got {layout!r}")
-        try:
-            iw, ih = (int(v) for v in input_size)
-        except (TypeError, ValueError):
-            raise ValueError(f"input_size: expected (width, height), got {input_size!r}") from None
-        if iw < 8 or ih < 8:
-            raise ValueError(f"input_size: expected at least 8×8 pixels, got {input_size!r}")
+        iw, ih = int_pair("input_size", input_size, ("width", "height"), 8)
         self.score_threshold = in_range("score_threshold", score_threshold, 0.0, 1.0)
         self.iou_threshold = in_range("iou_threshold", iou_threshold, 0.0, 1.0)
         self.layout: YoloLayout = layout
