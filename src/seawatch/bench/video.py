@@ -368,10 +368,21 @@ class _ThreadClock:
         return {k: v for k, v in out.items() if v > 0.0}
 
 
-def _timed(fn: Callable[[], int]) -> tuple[float, float, int, float | None, dict[str, float]]:
-    """Wall-clock and process CPU seconds of ``fn()``, the frames it reports, the
-    percentage of the machine's CPU time stolen by the hypervisor meanwhile (None where
-    unknown) and the CPU seconds per thread name (empty where unknown)."""
+@dataclass(frozen=True)
+class _Run:
+    """One timed run: wall-clock and process CPU seconds, the frames done, the percentage
+    of the machine's CPU time stolen by the hypervisor meanwhile (None where unknown) and
+    the CPU seconds per thread name (empty where unknown)."""
+
+    wall: float
+    cpu: float
+    frames: int
+    steal: float | None
+    threads: dict[str, float]
+
+
+def _timed(fn: Callable[[], int]) -> _Run:
+    """:class:`_Run` of ``fn()`` (which returns the frames it did)."""
     s0 = _cpu_ticks()
     clock = _ThreadClock()
     t0, c0 = time.perf_counter(), time.process_time()
@@ -382,7 +393,7 @@ def _timed(fn: Callable[[], int]) -> tuple[float, float, int, float | None, dict
     steal = None
     if s0 is not None and s1 is not None and s1[1] > s0[1]:
         steal = 100.0 * (s1[0] - s0[0]) / (s1[1] - s0[1])
-    return wall, cpu, n, steal, threads
+    return _Run(wall, cpu, n, steal, threads)
 
 
 # --------------------------------------------------------------------------------------
@@ -510,12 +521,12 @@ def run(
             "decode+horizon+detect+track": lambda: _stage(clip),
             "track_video": lambda: _track_video(clip, tmp_path / "out"),
         }
-        best: dict[str, tuple[float, float, int, float | None, dict[str, float]]] = {}
+        best: dict[str, _Run] = {}
         for name in VARIANTS:
             say(name)
             for _ in range(repeats):
                 t = _timed(runs[name])
-                if name not in best or t[0] < best[name][0]:
+                if name not in best or t.wall < best[name].wall:
                     best[name] = t
         say("agreement")
         _stage(clip, stage_rows)  # untimed: the image stage's tracks for the comparison
@@ -524,19 +535,19 @@ def run(
     stage = np.concatenate(stage_rows) if stage_rows else np.empty((0, 6))
     q = quality(table, truth)
     same, diff = _same_tracks(stage, table)
-    fps_of = {k: b[2] / b[0] for k, b in best.items()}
-    cpu_of = {k: (b[2] / b[1] if b[1] > 0 else math.inf) for k, b in best.items()}
+    fps_of = {k: b.frames / b.wall for k, b in best.items()}
+    cpu_of = {k: (b.frames / b.cpu if b.cpu > 0 else math.inf) for k, b in best.items()}
     results = [
         {
             "name": k,
             "value": fps_of[k],
             "unit": "frames/s",
             "cpu_time_frames_per_s": cpu_of[k],
-            "steal_percent": best[k][3],
+            "steal_percent": best[k].steal,
             "thread_cpu_ms_per_frame": {
-                name: 1000.0 * sec / max(best[k][2], 1) for name, sec in best[k][4].items()
+                name: 1000.0 * sec / max(best[k].frames, 1) for name, sec in best[k].threads.items()
             },
-            "frames": best[k][2],
+            "frames": best[k].frames,
         }
         for k in VARIANTS
     ]
