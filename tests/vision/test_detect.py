@@ -653,6 +653,30 @@ def test_pale_superstructure_five_times_fainter_than_its_hull_is_inside_the_box(
     assert abs(det.v_wl[k] - 240.5) <= 0.3, det.v_wl[k]  # the hull's water line
 
 
+def test_dark_hull_between_bright_glint_streaks_is_boxed_alone():
+    """A dark hull (−60 grey levels, 50 × 7 px, with a superstructure) with a bright sun
+    glint streak (+60, 40 px long) beside it on either side, touching it, at its water
+    line's rows — the lighting case's low sun. Hull and glint are of opposite
+    polarities and not stacked, so they are not one object: the hull's box is its own
+    (within a pixel), its water line is the hull's. Measured before the polarity split:
+    one 137 px box from the left streak's start to the right streak's end."""
+    rng = np.random.default_rng(77)
+    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
+    img = base.copy()
+    bright = float(np.median(base[195:225, 240:400])) + 60.0
+    paint_polygon(img, [(262.0, 205.5), (302.0, 205.5), (302.0, 209.5), (262.0, 209.5)], bright)
+    t = box_ship(img, base, 330.0, 210.5, 50, 7, -60, sup=(0.4, 4))
+    paint_polygon(img, [(358.0, 207.5), (400.0, 207.5), (400.0, 212.5), (358.0, 212.5)], bright)
+    img = as_u8(cv2.GaussianBlur(img, (0, 0), 0.7) + rng.normal(0, 2.0, img.shape))
+    det = ClassicalShipDetector()(img, horizon=hz)
+    found, _ = match(det, np.array([t]), tol=3.0)
+    assert found[0] >= 0, det.boxes
+    k = found[0]
+    assert np.all(np.abs(det.boxes[k, :4] - t[:4]) <= 1.0), (det.boxes[k], t)
+    assert abs(det.v_wl[k] - t[5]) <= 0.3, (det.v_wl[k], t[5])
+    assert not np.any(det.w > 60), det.boxes  # no box spans hull and glint
+
+
 @pytest.mark.parametrize("refine", REFINE)
 def test_rendered_footage_water_line_matches_truth_within_the_renderers_fill(tmp_path, refine):
     """Rendered H.264 footage (``seawatch.synth.render``): a 50 m ferry 800 m out and a

@@ -31,7 +31,7 @@ Colour frames are taken in OpenCV's BGR(A) order; grey frames may be 8-bit, 16-b
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Literal, Protocol, runtime_checkable
 
 import cv2
@@ -336,20 +336,26 @@ def _contrast_kernel(  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _grow_kernel(z, threshold, border, grow, visited, queue):  # pragma: no cover - compiled
+def _grow_kernel(z, sign, threshold, border, grow, visited, queue):  # pragma: no cover - compiled
     """Hysteresis segmentation: the 8-connected components of ``z > grow`` that hold a
     seed ``z > threshold`` (seeds in row-major order; none within ``border`` pixels of the
     left, right and bottom edges), found by breadth-first flood fill (cost ∝ their size).
 
+    ``sign`` (uint8, the shape of ``z``, or 1 × 1 for none) gives each pixel's polarity
+    bits (1 bright, 2 dark, 3 either): a component joins only pixels that share a bit
+    with its seed, so a dark hull and the bright glint beside it are two components.
     ``visited`` (uint8, flat, all zero) and ``queue`` (flat, size ≥ H·W) are work
     buffers, ``visited`` is zero again on return. Returns the inclusive boxes
-    ``(c0, r0, c1, r1)``, peak ``z`` and area [px] per component.
+    ``(c0, r0, c1, r1)``, peak ``z``, area [px] and polarity bits (the OR of its
+    pixels') per component.
     """
+    signed = sign.shape[0] == z.shape[0] and sign.shape[1] == z.shape[1]
     H, W = z.shape
     cap = 64
     boxes = np.empty((cap, 4), np.int64)
     peaks = np.empty(cap, np.float32)
     areas = np.empty(cap, np.int64)
+    pols = np.empty(cap, np.uint8)
     k = 0
     top = 0
     for sr in range(0, H - border):
@@ -372,6 +378,11 @@ def _grow_kernel(z, threshold, border, grow, visited, queue):  # pragma: no cove
                 areas2 = np.empty(cap, np.int64)
                 areas2[:k] = areas[:k]
                 areas = areas2
+                pols2 = np.empty(cap, np.uint8)
+                pols2[:k] = pols[:k]
+                pols = pols2
+            seed = sign[sr, sc] if signed else np.uint8(3)
+            pol = np.uint8(0)
             visited[p] = 1
             start = top
             queue[top] = p
@@ -389,10 +400,15 @@ def _grow_kernel(z, threshold, border, grow, visited, queue):  # pragma: no cove
                 c0 = min(c0, c)
                 c1 = max(c1, c)
                 pk = max(pk, z[r, c])
+                pol |= sign[r, c] if signed else np.uint8(3)
                 for rr in range(max(0, r - 1), min(H, r + 2)):
                     for cc in range(max(0, c - 1), min(W, c + 2)):
                         qq = rr * W + cc
-                        if visited[qq] == 0 and z[rr, cc] > grow:
+                        if (
+                            visited[qq] == 0
+                            and z[rr, cc] > grow
+                            and (not signed or sign[rr, cc] & seed)
+                        ):
                             visited[qq] = 1
                             queue[top] = qq
                             top += 1
@@ -402,10 +418,11 @@ def _grow_kernel(z, threshold, border, grow, visited, queue):  # pragma: no cove
             boxes[k, 3] = r1
             peaks[k] = pk
             areas[k] = top - start
+            pols[k] = pol
             k += 1
     for i in range(top):
         visited[queue[i]] = 0
-    return boxes[:k], peaks[:k], areas[:k]
+    return boxes[:k], peaks[:k], areas[:k], pols[:k]
 
 
 @njit(cache=True, nogil=True)
@@ -608,6 +625,9 @@ class PreparedFrame:
     ends: tuple[float, float] | None
 
 
+_NO_SIGN = np.full((1, 1), 3, np.uint8)  # one polarity only: every pixel joins
+
+
 @dataclass
 class _Level:
     """Contrast maps of one scale: level pixel (i, j) covers working pixels
@@ -619,6 +639,8 @@ class _Level:
     sigma: NDArray  # robust noise level [units]
     z: NDArray  # contrast / noise
     chroma: list[tuple[int, NDArray, NDArray, NDArray]] | None = None  # (channel, hi, lo, σ)
+    sign: NDArray = field(default_factory=lambda: _NO_SIGN)  # polarity bits per pixel
+    # (1 bright, 2 dark, 3 either)
 
 
 @dataclass
@@ -679,6 +701,7 @@ class _Candidate:
     box: NDArray  # x0, y0, x1, y1: inclusive working-pixel indices in the band
     level: int
     peak: float  # peak z
+    polarity: int = 3  # bits: 1 bright, 2 dark (3: both, or a colour contrast)
 
 
 class _TemporalModel:
@@ -931,7 +954,7 @@ class ClassicalShipDetector:
         # merged, a ship's candidate reaches down to its hull: one whose bottom is above
         # the sea by more than its height is a cloud or a coast feature
         cands = [c for c in cands if self._near_sea(c, fr, mask, ends, tol, 1.0)]
-        out = []
+        out, polarity = [], []
         for c in cands:
             refine = self._refine if self.refine == "flank" else self._refine_mask
             for x, y, w, h, u, v, area in refine(c, levels[c.level], fr):
@@ -947,11 +970,13 @@ class ClassicalShipDetector:
                     continue
                 score = 1.0 - math.exp(-0.5 * (c.peak / self.threshold) ** 2)
                 out.append((x, y, w, h, score, u, v))
+                polarity.append(c.polarity)
         if not out:
             return Detections.empty()
         arr = np.array(out, dtype=np.float64)
-        arr = arr[np.argsort(-arr[:, 4], kind="stable")]
-        return Detections(arr[_distinct(arr)])
+        order = np.argsort(-arr[:, 4], kind="stable")
+        arr = arr[order]
+        return Detections(arr[_distinct(arr, np.array(polarity)[order])])
 
     def _frame(
         self,
@@ -1107,6 +1132,9 @@ class ClassicalShipDetector:
         if self.temporal:
             c, sigma = self._apply_temporal(gs, hi, lo, d, sigma, fr, factor)
         z = np.divide(c, sigma, out=c)
+        sign = _NO_SIGN
+        if pol == 0:  # bright where g > (L + R)/2 (then g − max(L, R) > min(L, R) − g)
+            sign = np.add(d <= 0, 1, dtype=np.uint8)
         chroma = None
         if factor == 1 and fr.chroma:
             chroma = []
@@ -1118,9 +1146,11 @@ class ClassicalShipDetector:
                     plane, f"c{ch_index}", 1, 2.0 * floor, gc, fc, 0
                 )
                 zc = cv2.resize(np.divide(cc, sc, out=cc), (z.shape[1], z.shape[0]))
+                if pol == 0:  # a colour contrast has no brightness polarity
+                    np.putmask(sign, zc > z, 3)
                 np.maximum(z, zc, out=z)
                 chroma.append((ch_index, hc, lc, sc))
-        return _Level(factor, hi, lo, sigma, z, chroma)
+        return _Level(factor, hi, lo, sigma, z, chroma, sign)
 
     def _apply_temporal(
         self,
@@ -1200,8 +1230,9 @@ class ClassicalShipDetector:
             hz, wz = z.shape
             visited = self._work(f"visited{f}", hz * wz, np.uint8, zero=True)
             queue = self._work(f"queue{f}", hz * wz, np.int64)
-            boxes, peaks, _ = _grow_kernel(
+            boxes, peaks, _, pols = _grow_kernel(
                 z,
+                lv.sign,
                 np.float32(self.threshold),
                 b,
                 np.float32(self.grow_threshold),
@@ -1216,7 +1247,7 @@ class ClassicalShipDetector:
             for i in np.flatnonzero(ok)[np.argsort(-peaks[ok])][: self.max_candidates]:
                 x0, y0, x1, y1 = boxes[i]
                 box = np.array([x0 * f, y0 * f, (x1 + 1) * f - 1, (y1 + 1) * f - 1], float)
-                cands.append(_Candidate(box, k, float(peaks[i])))
+                cands.append(_Candidate(box, k, float(peaks[i]), int(pols[i])))
         return cands
 
     def _clutter_test(self, cands: list[_Candidate], lv0: _Level) -> list[_Candidate]:
@@ -1270,7 +1301,8 @@ class ClassicalShipDetector:
     def _resolve_scales(self, cands: list[_Candidate]) -> list[_Candidate]:
         """Coarse-to-fine arbitration: a coarse candidate narrow enough for the next finer
         scale gives way to the finer candidates it overlaps; a wider one replaces the
-        finer candidates that lie (at least half) inside it."""
+        finer candidates that lie (at least half) inside it — of a shared polarity only
+        (a dark hull inside a wide bright glint path stays)."""
         if len({c.level for c in cands}) < 2:
             return cands
         alive = [True] * len(cands)
@@ -1280,7 +1312,11 @@ class ClassicalShipDetector:
                 continue
             capacity = (2 * self.guard + 1) * 3 ** (ci.level - 1)
             width = ci.box[2] - ci.box[0] + 1
-            finer = [j for j, c in enumerate(cands) if alive[j] and c.level < ci.level]
+            finer = [
+                j
+                for j, c in enumerate(cands)
+                if alive[j] and c.level < ci.level and c.polarity & ci.polarity
+            ]
             if width <= capacity:
                 if any(_overlap(cands[j].box, ci.box) for j in finer):
                     alive[i] = False
@@ -1291,28 +1327,40 @@ class ClassicalShipDetector:
                         ci.peak = max(ci.peak, cands[j].peak)
         return [c for c, a in zip(cands, alive, strict=True) if a]
 
-    def _mergeable(self, a: NDArray, b: NDArray) -> bool:
-        """:meth:`_merge`'s rule for two inclusive boxes ``(x0, y0, x1, y1)``."""
+    def _mergeable(self, a: _Candidate, b: _Candidate) -> bool:
+        """:meth:`_merge`'s rule for two candidates (inclusive boxes ``(x0, y0, x1, y1)``):
+        near on one axis and overlapping on the other; of opposite polarities (one
+        bright, one dark) only when stacked — one above the other on shared columns, its
+        top and bottom higher than the other's (a pale superstructure on a dark hull,
+        not the bright glint beside or around a dark hull)."""
+        a, b, opposite = a.box, b.box, not a.polarity & b.polarity
         gap = max(1.0, self.merge_gap * (min(a[3] - a[1], b[3] - b[1]) + 1))
         gx = max(a[0], b[0]) - min(a[2], b[2]) - 1
         gy = max(a[1], b[1]) - min(a[3], b[3]) - 1
+        if opposite:
+            upper, lower = (a, b) if a[1] + a[3] < b[1] + b[3] else (b, a)
+            return bool(gx < 0 and gy <= gap and upper[1] < lower[1] and upper[3] <= lower[3])
         return bool((gx < 0 and gy <= gap) or (gy < 0 and gx <= gap) or max(gx, gy) < 1)
 
     def _merge(self, cands: list[_Candidate]) -> list[_Candidate]:
         """Merge the fragments of one ship (hull and superstructure, a hull cut by a wave):
         boxes that overlap on one axis with a gap of at most ``merge_gap`` × the smaller
-        box height (at least one pixel) on the other, or that touch diagonally."""
+        box height (at least one pixel) on the other, or that touch diagonally; of
+        opposite polarities only when stacked (:meth:`_mergeable`)."""
         cands = list(cands)
         changed = True
         while changed and len(cands) > 1:
             changed = False
             for i in range(len(cands)):
                 for j in range(i + 1, len(cands)):
-                    a, b = cands[i].box, cands[j].box
-                    if self._mergeable(a, b):
+                    if self._mergeable(cands[i], cands[j]):
+                        a, b = cands[i].box, cands[j].box
                         box = np.concatenate([np.minimum(a[:2], b[:2]), np.maximum(a[2:], b[2:])])
                         level = min(cands[i].level, cands[j].level)
-                        cands[i] = _Candidate(box, level, max(cands[i].peak, cands[j].peak))
+                        peak = max(cands[i].peak, cands[j].peak)
+                        cands[i] = _Candidate(
+                            box, level, peak, cands[i].polarity | cands[j].polarity
+                        )
                         del cands[j]
                         changed = True
                         break
@@ -1859,13 +1907,16 @@ def _line_values(
     return cv2.remap(lines, cx, cy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
 
 
-def _distinct(rows: NDArray, overlap: float = 0.7, wl_tol: float = 0.5) -> NDArray[np.intp]:
+def _distinct(
+    rows: NDArray, polarity: NDArray | None = None, overlap: float = 0.7, wl_tol: float = 0.5
+) -> NDArray[np.intp]:
     """Indices (in the given order) of the detections (rows of :data:`DETECTION_COLUMNS`)
     that are no part of another: taken largest box first, a detection is dropped when
-    more than ``overlap`` of its box lies inside a kept box and its water line is not
-    more than ``wl_tol`` [px] below that one's (two candidates that refined to one ship,
-    or a superstructure boxed alone; a ship in front of another has its own, lower,
-    water line and stays)."""
+    more than ``overlap`` of its box lies inside a kept box of a shared ``polarity``
+    (bits: 1 bright, 2 dark; None: all shared) and its water line is not more than
+    ``wl_tol`` [px] below that one's (two candidates that refined to one ship, or a
+    superstructure boxed alone; a ship in front of another has its own, lower, water
+    line and stays, and so does a dark hull inside a bright glint path's box)."""
     order = np.argsort(-(rows[:, 2] * rows[:, 3]), kind="stable")
     keep: list[int] = []
     for i in order.tolist():
@@ -1880,6 +1931,7 @@ def _distinct(rows: NDArray, overlap: float = 0.7, wl_tol: float = 0.5) -> NDArr
                 and ih > 0
                 and iw * ih > overlap * w * h
                 and rows[i, 6] <= rows[j, 6] + wl_tol
+                and (polarity is None or polarity[i] & polarity[j])
             ):
                 dup = True
                 break
