@@ -57,3 +57,34 @@ def test_parquet_copy_holds_the_csv_rows(tmp_path):
     out = w.close()
     table = pq.read_table(out[1]).to_pydict()
     assert table == {"a": [1], "b": [2.5]}
+
+
+def test_a_flush_cut_by_an_interrupt_writes_no_row_twice_and_counts_what_is_in_the_file(
+    tmp_path,
+):
+    """SIGTERM/Ctrl-C (KeyboardInterrupt) right after a flush's write and before it
+    returns: ``close`` flushes again, which must not repeat the rows already handed
+    over; ``rows`` equals the rows in the file (the track job reports it)."""
+    w = TableWriter(tmp_path / "t.csv", ["a", "b"])
+    real = w._fh
+
+    class CutAfterWrite:
+        closed = False
+
+        def write(self, data):
+            real.write(data)
+            raise KeyboardInterrupt  # arrives once the bytes are in the file
+
+        def close(self):
+            real.close()
+
+    w.write({"a": 1, "b": 2})
+    w.write({"a": 3, "b": 4})
+    w._fh = CutAfterWrite()
+    with pytest.raises(KeyboardInterrupt):
+        w.flush()
+    w._fh = real
+    w.close()
+    lines = (tmp_path / "t.csv").read_text().splitlines()
+    assert lines == ["a,b", "1,2", "3,4"]
+    assert w.rows == 2

@@ -75,8 +75,9 @@ class TableWriter:
         self._buf = io.StringIO()
         self._csv = csv.writer(self._buf)
         self._csv.writerow(self.columns)
-        self.flush()
         self.rows = 0
+        self.flush()
+        self.rows = 0  # the header is no row
 
     def write(self, row: Mapping[str, Any]) -> None:
         """Append one row (a mapping column → value); not flushed until :meth:`flush`."""
@@ -84,18 +85,21 @@ class TableWriter:
         self._csv.writerow(cells)
         if self._kept is not None:
             self._kept.append(cells)
-        self.rows += 1
 
     def flush(self) -> None:
         """Hand the rows written since the last flush to the operating system in one write
-        (call once per frame)."""
+        (call once per frame). ``rows`` counts the rows handed over: the buffer is taken
+        before the write, so a flush cut short by Ctrl-C or SIGTERM (``close`` flushes
+        again) never writes a row twice, and ``rows`` is the number of rows in the file."""
         data = self._buf.getvalue().encode("utf-8")
         if data:
+            self._buf.seek(0)
+            self._buf.truncate()
+            # counted first: a signal's handler runs when the write returns
+            self.rows += data.count(b"\n")  # one line per row: cells hold no newline
             view = memoryview(data)
             while view:  # a regular file takes it whole; the loop covers short writes
                 view = view[self._fh.write(view) :]
-            self._buf.seek(0)
-            self._buf.truncate()
 
     def close(self) -> list[Path]:
         """Close the CSV (and write the Parquet copy); returns the files written."""
