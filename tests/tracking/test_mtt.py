@@ -310,6 +310,26 @@ def test_overlap_stage_keeps_the_id_of_a_re_segmented_box_and_restarts_its_centr
     assert st.boxes[0, 3] == pytest.approx(75.0, abs=1.0)
 
 
+def test_overlap_stage_does_not_restart_a_boat_on_the_box_of_ships_merged_over_it():
+    """A 16 × 5 px boat whose detection is, for two frames, one 114 × 32 px box of the
+    ships passing in front of it (centre 47 px away, 45 × its area; rendered crossing
+    case): the boat's track coasts instead of jumping to the merged box, and takes its
+    own box again afterwards under the same id."""
+    trk = _tracker(confirm_m=2, confirm_n=3, overlap_gate=0.5)
+    boat = lambda k: np.array([[420.0 + k, 245.0, 16.0, 5.0]])  # noqa: E731
+    for k in range(10):
+        st = trk.step(boat(k))
+    (boat_id,) = st.confirmed_tracks().ids
+    for k in (10, 11):
+        st = trk.step(np.array([[418.0 + k, 219.0, 114.0, 32.0]]))  # centre 47 px off
+        assert not st.restarted.any()
+        own = st.ids == boat_id
+        assert st.detection[own].tolist() == [-1]  # coasting, not restarted
+        assert st.states[own, 0] == pytest.approx(428.0 + k, abs=0.5)
+    st = trk.step(boat(12))
+    assert st.detection[st.ids == boat_id].tolist() == [0]
+
+
 def test_overlap_stage_never_takes_a_detection_the_gate_paired_or_a_far_one():
     trk = _tracker(confirm_m=1, confirm_n=1, overlap_gate=0.5)
     trk.step(np.array([[0.0, 0.0, 10.0, 10.0], [100.0, 0.0, 10.0, 10.0]]))

@@ -63,6 +63,10 @@ __all__ = [
 
 _DIM = 2  # tracked position axes
 _N = 2 * _DIM  # state size [x, y, vx, vy]
+_RESTART_GROWTH = 10.0
+"""Largest ratio of a detection's box area to a track's for the overlap stage's restart
+(a hull that gains its superstructure: a few times; a boat merged into the box of the
+ships passing in front of it: tens of times)."""
 _UNGATED = 1.0e12  # cost of a pair outside the gate inside the assignment solver
 
 
@@ -635,14 +639,12 @@ class MultiTargetTracker:
         free_d = np.setdiff1d(np.arange(z.shape[0]), cols)
         if free_t.size == 0 or free_d.size == 0:
             return empty, empty
-        tc, ts = self._X[free_t, :_DIM], self._size[free_t]
         dc, ds = z[free_d], sizes[free_d]
-        lo = np.maximum(tc[:, None] - 0.5 * ts[:, None], dc[None] - 0.5 * ds[None])
-        hi = np.minimum(tc[:, None] + 0.5 * ts[:, None], dc[None] + 0.5 * ds[None])
-        inter = np.prod(np.clip(hi - lo, 0.0, None), axis=2)
-        smaller = np.minimum(np.prod(ts, axis=1)[:, None], np.prod(ds, axis=1)[None])
-        with np.errstate(invalid="ignore", divide="ignore"):
-            ov = np.where(smaller > 0.0, inter / smaller, 0.0)
+        ov = self._overlaps(free_t, dc, ds)
+        # a box many times larger than the track's is no re-segmentation of its ship but
+        # ships merged into one box (one passing in front of another): no restart
+        area_t = np.prod(self._size[free_t], axis=1)
+        ov[np.prod(ds, axis=1)[None] > _RESTART_GROWTH * area_t[:, None]] = 0.0
         if self.confirmed_first:  # pairs in the gate: most detections first, then overlap
             hits = np.where(ov >= self.overlap_gate, self._hits[free_t][:, None], -1)
             order = np.lexsort((-ov.ravel(), -hits.ravel()))
@@ -658,6 +660,17 @@ class MultiTargetTracker:
             out_r.append(int(free_t[i]))
             out_c.append(int(free_d[j]))
         return np.array(out_r, np.int64), np.array(out_c, np.int64)
+
+    def _overlaps(self, tracks: NDArray[np.int64], dc: FloatArray, ds: FloatArray) -> FloatArray:
+        """Overlap (intersection over the smaller area) of the predicted boxes of
+        ``tracks`` (predicted centres, smoothed sizes) with the boxes ``dc`` ± ``ds``/2."""
+        tc, ts = self._X[tracks, :_DIM], self._size[tracks]
+        lo = np.maximum(tc[:, None] - 0.5 * ts[:, None], dc[None] - 0.5 * ds[None])
+        hi = np.minimum(tc[:, None] + 0.5 * ts[:, None], dc[None] + 0.5 * ds[None])
+        inter = np.prod(np.clip(hi - lo, 0.0, None), axis=2)
+        smaller = np.minimum(np.prod(ts, axis=1)[:, None], np.prod(ds, axis=1)[None])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(smaller > 0.0, inter / smaller, 0.0)
 
     def _restart(self, rows: NDArray[np.int64], z: FloatArray, sizes: FloatArray) -> None:
         """Restart tracks ``rows`` at detections ``z`` with their velocity and id kept:
