@@ -1498,18 +1498,22 @@ class ClassicalShipDetector:
         if not ships:
             if not keep:
                 return None
-            ships = [(0, obj_box.shape[1] - 1, 0, obj_box.shape[0] - 1, None, None)]
+            ships = [(0, obj_box.shape[1] - 1, 0, obj_box.shape[0] - 1, None, None, None)]
         out = []
-        for sc0, sc1, sr0, sr1, u, v in ships:
+        for sc0, sc1, sr0, sr1, u, v, low in ships:
             ship = obj_box[sr0 : sr1 + 1, sc0 : sc1 + 1]
             x, y = X0 + sc0 - 0.5, Y0 + sr0 - 0.5
             if u is None or v is None:  # no measurable hull/sea edge: the mask's bottom
                 uu, vv = _waterline(ship)
                 u, v = x + uu, y + vv
             w, h = float(sc1 - sc0 + 1), float(sr1 - sr0 + 1)
-            # the box holds its water line: a sub-pixel edge may lie in the row below the
-            # last half-covered one
-            h = max(h, float(v) - y)
+            if low is not None and low > y:
+                # a ship's lowest point is on its water line: the box ends there, to a
+                # fraction of a pixel (the smoothing's spill below a strong hull can
+                # hold a half-covered row under it)
+                h = float(low) - y
+            else:  # the box holds its water line: a sub-pixel edge may lie in the row
+                h = max(h, float(v) - y)  # below the last half-covered one
             out.append((x, y, w, h, u, v, float(np.count_nonzero(ship))))
         return out
 

@@ -468,11 +468,12 @@ def _hull_contrast_kernel(rgb, cols, bottom):  # pragma: no cover - compiled
 
 def _frame_ships(
     fr: _Frame, obj: NDArray[np.bool_], x0: int, y0: int, colour: bool = False
-) -> list[tuple[int, int, int, int, float | None, float | None]]:
+) -> list[tuple[int, int, int, int, float | None, float | None, float | None]]:
     """The ships of an object mask whose top-left pixel is frame pixel ``(x0, y0)``, read
-    from the full-resolution grey frame: per ship ``(c0, c1, r0, r1, u, v)``, its
-    columns and rows (inclusive, mask pixels) and its water-line point [frame px] (None
-    when too faint; :func:`_edge_waterline`). One ship unless the water line jumps
+    from the full-resolution grey frame: per ship ``(c0, c1, r0, r1, u, v, low)``, its
+    columns and rows (inclusive, mask pixels), its water-line point and the lowest point
+    of its water line over the columns whose edge was measured (the silhouette's bottom)
+    [frame px] (None when too faint; :func:`_edge_waterline`). One ship unless the water line jumps
     (:func:`_waterline_levels`): then per ship its columns' span, the rows of its columns
     and the water line of its columns. None at all when the object is no ship: its
     water-line edges scatter about their line by more than :data:`_WL_RAGGED` (sun
@@ -504,12 +505,14 @@ def _frame_ships(
         if int(keep.sum()) < max(2, 0.25 * n_hull):
             if n_hull >= _WL_MIN_COLUMNS:
                 return []  # a large object without a water line: not a ship
-            return [(0, w - 1, 0, h - 1, None, None)]
+            return [(0, w - 1, 0, h - 1, None, None, None)]
         u = 0.5 * (float(cols[hull][0]) + float(cols[hull][-1]))
-        v, _, ragged = _theil_sen(cols[keep].astype(np.float64), edge[keep], u)
+        v, slope, ragged = _theil_sen(cols[keep].astype(np.float64), edge[keep], u)
         if ragged > _WL_RAGGED:
             return []
-        return [(0, w - 1, 0, h - 1, x0 + u, y0 + v)]
+        ends = cols[keep][[0, -1]] - u
+        low = v + max(slope * float(ends[0]), slope * float(ends[1]))
+        return [(0, w - 1, 0, h - 1, x0 + u, y0 + v, y0 + low)]
     fits = []
     for g in groups:
         x = cols[g].astype(np.float64)
@@ -528,7 +531,7 @@ def _frame_ships(
     on_levels = sum(g.size for g in groups)
     if on_levels < 0.5 * meas.sum() or 1.4826 * float(np.median(np.abs(resid))) > _WL_RAGGED:
         return []
-    out: list[tuple[int, int, int, int, float | None, float | None]] = []
+    out: list[tuple[int, int, int, int, float | None, float | None, float | None]] = []
     for k, g in enumerate(groups):
         own = near == k
         own[g] = True
@@ -538,7 +541,10 @@ def _frame_ships(
         r1 = int(bottom[own].max())
         u = 0.5 * (c0 + c1)
         m, v, slope = fits[k]
-        out.append((c0, c1, r0, r1, x0 + u, y0 + v + slope * (u - m)))
+        ec = cols[own & meas]  # the columns whose edge was measured
+        ends = (ec.min(), ec.max()) if ec.size else (c0, c1)
+        low = v + max(slope * (float(ends[0]) - m), slope * (float(ends[1]) - m))
+        out.append((c0, c1, r0, r1, x0 + u, y0 + v + slope * (u - m), y0 + low))
     return out
 
 
