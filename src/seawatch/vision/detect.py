@@ -1134,7 +1134,9 @@ class ClassicalShipDetector:
         z = np.divide(c, sigma, out=c)
         sign = _NO_SIGN
         if pol == 0:  # bright where g > (L + R)/2 (then g − max(L, R) > min(L, R) − g)
-            sign = np.add(d <= 0, 1, dtype=np.uint8)
+            sign = self._work(f"sign{factor}", d.shape, np.uint8)
+            np.less_equal(d, 0, out=sign.view(np.bool_))
+            sign += 1
         chroma = None
         if factor == 1 and fr.chroma:
             chroma = []

@@ -466,6 +466,12 @@ def _hull_contrast_kernel(rgb, cols, bottom):  # pragma: no cover - compiled
     return hull, 1.4826 * _median_f32(dev)
 
 
+def _line_low(v: float, slope: float, at: float, cols: NDArray) -> float:
+    """Lowest point (largest row) [px] of the line ``v + slope · (c − at)`` over the
+    columns ``cols`` (ascending): at the first or the last of them."""
+    return v + max(slope * (float(cols[0]) - at), slope * (float(cols[-1]) - at))
+
+
 def _frame_ships(
     fr: _Frame, obj: NDArray[np.bool_], x0: int, y0: int, colour: bool = False
 ) -> list[tuple[int, int, int, int, float | None, float | None, float | None]]:
@@ -510,8 +516,7 @@ def _frame_ships(
         v, slope, ragged = _theil_sen(cols[keep].astype(np.float64), edge[keep], u)
         if ragged > _WL_RAGGED:
             return []
-        ends = cols[keep][[0, -1]] - u
-        low = v + max(slope * float(ends[0]), slope * float(ends[1]))
+        low = _line_low(v, slope, u, cols[keep])
         return [(0, w - 1, 0, h - 1, x0 + u, y0 + v, y0 + low)]
     fits = []
     for g in groups:
@@ -542,8 +547,7 @@ def _frame_ships(
         u = 0.5 * (c0 + c1)
         m, v, slope = fits[k]
         ec = cols[own & meas]  # the columns whose edge was measured
-        ends = (ec.min(), ec.max()) if ec.size else (c0, c1)
-        low = v + max(slope * (float(ends[0]) - m), slope * (float(ends[1]) - m))
+        low = _line_low(v, slope, m, ec if ec.size else np.array([c0, c1]))
         out.append((c0, c1, r0, r1, x0 + u, y0 + v + slope * (u - m), y0 + low))
     return out
 
