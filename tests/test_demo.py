@@ -91,8 +91,8 @@ def test_demo_ekf_no_worse_than_geometry_in_any_range_bin(demo) -> None:
     the EKF's lag adds a little. The 250–500 m bin (one vessel at ~420 m) is such a bin:
     its measured water line lies 0.63 px (sd 0.16 px) below the truth's midship point —
     the hull's near side, half a beam (5.4 m at f = 2059 px, 10 m camera) nearer —
-    geometry 5.92 m, EKF 6.08 m (session 8; before the detector's polarity split the
-    water line scattered by 0.79 px and geometry was 8.0 m)."""
+    geometry 5.91 m, EKF 6.04 m (session 8; before the detector's polarity split the
+    water line scattered by 0.79 px and geometry was 8.1 m)."""
     est = demo[0]["errors"]["estimators"]
     geo = {b["range_from_m"]: b["rmse_position_m"] for b in est["geometry"]["range_bins"]}
     for b in est["ekf"]["range_bins"]:
