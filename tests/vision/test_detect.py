@@ -617,6 +617,27 @@ def test_ship_in_front_of_another_gives_two_boxes_with_their_own_water_lines(ref
     np.testing.assert_allclose(det.x[found] + det.w[found], truth[:, 0] + truth[:, 2], atol=1.0)
 
 
+@pytest.mark.parametrize("seed", [1234, 99])
+def test_ship_one_pixel_nearer_than_the_one_behind_it_gives_two_boxes(seed):
+    """Two ships whose water lines are 1.0 px apart (a 40 px ship in front of the middle
+    of a 90 px one, the overtaking case's geometry at 960×540): two boxes, each with its
+    own water line and sides. With the 1 px jump for every split (before) they were one
+    box: the running medians put the step at 0.9–1.0 px."""
+    rng = np.random.default_rng(seed)
+    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
+    img = base.copy()
+    far = box_ship(img, base, 300.0, 200.4, 90, 7, -45, sup=(1 / 3, 6))
+    near = box_ship(img, base, 280.0, 201.4, 40, 8, -70, sup=(0, 0))
+    img = as_u8(cv2.GaussianBlur(img, (0, 0), 0.7) + rng.normal(0, 2.0, img.shape))
+    det = ClassicalShipDetector()(img, horizon=hz)
+    truth = np.array([far, near])
+    found, n_false = match(det, truth)
+    assert (found >= 0).all() and n_false == 0, det.boxes
+    np.testing.assert_allclose(det.v_wl[found], truth[:, 5], atol=0.2)
+    np.testing.assert_allclose(det.x[found], truth[:, 0], atol=1.0)
+    np.testing.assert_allclose(det.x[found] + det.w[found], truth[:, 0] + truth[:, 2], atol=1.0)
+
+
 @pytest.mark.parametrize("refine", REFINE)
 def test_thin_mast_is_inside_the_box(refine):
     rng = np.random.default_rng(1234)

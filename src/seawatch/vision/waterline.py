@@ -374,6 +374,7 @@ def _waterline_levels(
     jump: float = 1.0,
     hull: NDArray | None = None,
     sigma: float = 0.0,
+    jump_in_front: float = 0.8,
 ) -> list[NDArray] | None:
     """Columns of the ships in one object mask whose water line jumps: two ships at
     different ranges, one in front of the other or side by side (the farther one's water
@@ -396,7 +397,36 @@ def _waterline_levels(
     ships' hulls must also differ — by at least ``max(8 σ, 0.08 × the hulls' typical
     contrast)`` (``sigma`` the noise): one hull whose drawn water line steps by a pixel
     (a sloping edge rendered without anti-aliasing) stays one ship.
+
+    A smaller jump, ``jump_in_front`` = 0.8 px, splits a ship seen in front of another's
+    middle: the farther level on both sides of the nearer one's columns, which no single
+    hull draws (its stern steps at one end). In the rendered overtaking case (1.0–1.1 px
+    apart) the near ship is then boxed (IoU ≥ 0.5) in 177 of 200 frames instead of 143;
+    the demo's boxes are unchanged. Two levels side by side keep ``jump``: at 0.8 px the
+    demo's one hull split in 21 of 261 frames (3 at 1 px) and its tracker made 3 ID
+    switches instead of 1.
     """
+    found = _split_levels(cols, edge, jump, hull, sigma)
+    if found is not None or jump_in_front >= jump:
+        return found
+    found = _split_levels(cols, edge, jump_in_front, hull, sigma)
+    if found is None:
+        return None
+    # the smaller jump only for a ship in front of another's middle: the far ship's
+    # level on both sides of the near one's columns
+    order = sorted(range(len(found)), key=lambda k: float(np.median(edge[found[k]])))
+    for a, far in enumerate(order):
+        for near in order[a + 1 :]:
+            c_far, c_near = cols[found[far]], cols[found[near]]
+            if c_far.min() < c_near.min() and c_far.max() > c_near.max():
+                return found
+    return None
+
+
+def _split_levels(
+    cols: NDArray, edge: NDArray, jump: float, hull: NDArray | None, sigma: float
+) -> list[NDArray] | None:
+    """:func:`_waterline_levels` for one jump ``jump`` [px]."""
     ok = np.flatnonzero(np.isfinite(edge))
     n = ok.size
     if n < 9:
