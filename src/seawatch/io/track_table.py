@@ -75,9 +75,11 @@ class TableWriter:
         self._buf = io.StringIO()
         self._csv = csv.writer(self._buf)
         self._csv.writerow(self.columns)
+        header = self._buf.getvalue().encode("utf-8")  # written now; it is no row
+        self._buf.seek(0)
+        self._buf.truncate()
+        self._fh.write(header)
         self.rows = 0
-        self.flush()
-        self.rows = 0  # the header is no row
 
     def write(self, row: Mapping[str, Any]) -> None:
         """Append one row (a mapping column → value); not flushed until :meth:`flush`."""

@@ -696,6 +696,10 @@ class _Frame:
         return x0, y0 + self.wtop + lo, x1, y1 + self.wtop + hi
 
 
+# a refined object: box x, y, w, h, water-line point u, v [px] and area [px²]
+_Object = tuple[float, float, float, float, float, float, float]
+
+
 @dataclass
 class _Candidate:
     box: NDArray  # x0, y0, x1, y1: inclusive working-pixel indices in the band
@@ -1370,9 +1374,7 @@ class ClassicalShipDetector:
                     break
         return cands
 
-    def _refine(
-        self, c: _Candidate, lv: _Level, fr: _Frame
-    ) -> list[tuple[float, float, float, float, float, float, float]]:
+    def _refine(self, c: _Candidate, lv: _Level, fr: _Frame) -> list[_Object]:
         """Full-resolution objects of a candidate: per object its box (x, y, w, h), water-
         line point (u, v) [px] and area [px²]; none when nothing stands out.
 
@@ -1455,7 +1457,7 @@ class ClassicalShipDetector:
             and not (b[2] == 0 and edges[2])
             and not (b[3] == last[1] and edges[3])
         ]
-        out: list[tuple[float, float, float, float, float, float, float]] = []
+        out: list[_Object] = []
         for group in _touching_groups(inside):
             found = self._ships(fr, win, sum(group[1:], group[0]), absdiff, colour)
             if found is None and len(group) > 1:  # no ship as a whole: its parts alone
@@ -1473,7 +1475,7 @@ class ClassicalShipDetector:
         absdiff: NDArray,
         colour: bool,
         keep: bool = False,
-    ) -> list[tuple[float, float, float, float, float, float, float]] | None:
+    ) -> list[_Object] | None:
         """Boxes, water-line points and areas of the ships in an object mask of the
         window ``win`` (:func:`_frame_ships`), from its pixels that are at least half
         covered: whose ``absdiff`` is at least half the largest within two pixels (the
@@ -1519,9 +1521,7 @@ class ClassicalShipDetector:
             out.append((x, y, w, h, u, v, float(np.count_nonzero(ship))))
         return out
 
-    def _refine_mask(
-        self, c: _Candidate, lv: _Level, fr: _Frame
-    ) -> list[tuple[float, float, float, float, float, float, float]]:
+    def _refine_mask(self, c: _Candidate, lv: _Level, fr: _Frame) -> list[_Object]:
         """``refine="mask"``: the objects of a candidate from its level's own contrast
         (class docstring, step 5): in the candidate's box plus a margin (a quarter of
         its height and the level's factor, at least two working pixels), the pixels

@@ -502,9 +502,14 @@ def _line_low(v: float, slope: float, at: float, cols: NDArray) -> float:
     return v + max(slope * (float(cols[0]) - at), slope * (float(cols[-1]) - at))
 
 
+# one ship of an object mask (:func:`_frame_ships`): its columns c0, c1 and rows r0, r1
+# (mask pixels, inclusive), water-line point u, v and lowest water-line point [frame px]
+_ShipSpan = tuple[int, int, int, int, float | None, float | None, float | None]
+
+
 def _frame_ships(
     fr: _Frame, obj: NDArray[np.bool_], x0: int, y0: int, colour: bool = False
-) -> list[tuple[int, int, int, int, float | None, float | None, float | None]]:
+) -> list[_ShipSpan]:
     """The ships of an object mask whose top-left pixel is frame pixel ``(x0, y0)``, read
     from the full-resolution grey frame: per ship ``(c0, c1, r0, r1, u, v, low)``, its
     columns and rows (inclusive, mask pixels), its water-line point and the lowest point
@@ -566,7 +571,7 @@ def _frame_ships(
     on_levels = sum(g.size for g in groups)
     if on_levels < 0.5 * meas.sum() or 1.4826 * float(np.median(np.abs(resid))) > _WL_RAGGED:
         return []
-    out: list[tuple[int, int, int, int, float | None, float | None, float | None]] = []
+    out: list[_ShipSpan] = []
     for k, g in enumerate(groups):
         own = near == k
         own[g] = True
