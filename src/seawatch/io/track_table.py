@@ -75,10 +75,7 @@ class TableWriter:
         self._buf = io.StringIO()
         self._csv = csv.writer(self._buf)
         self._csv.writerow(self.columns)
-        header = self._buf.getvalue().encode("utf-8")  # written now; it is no row
-        self._buf.seek(0)
-        self._buf.truncate()
-        self._fh.write(header)
+        self._write(self._take())  # the header: written now, and no row
         self.rows = 0
 
     def write(self, row: Mapping[str, Any]) -> None:
@@ -93,15 +90,23 @@ class TableWriter:
         (call once per frame). ``rows`` counts the rows handed over: the buffer is taken
         before the write, so a flush cut short by Ctrl-C or SIGTERM (``close`` flushes
         again) never writes a row twice, and ``rows`` is the number of rows in the file."""
-        data = self._buf.getvalue().encode("utf-8")
+        data = self._take()
         if data:
-            self._buf.seek(0)
-            self._buf.truncate()
             # counted first: a signal's handler runs when the write returns
             self.rows += data.count(b"\n")  # one line per row: cells hold no newline
-            view = memoryview(data)
-            while view:  # a regular file takes it whole; the loop covers short writes
-                view = view[self._fh.write(view) :]
+            self._write(data)
+
+    def _take(self) -> bytes:
+        """The buffered lines, encoded; the buffer is emptied."""
+        data = self._buf.getvalue().encode("utf-8")
+        self._buf.seek(0)
+        self._buf.truncate()
+        return data
+
+    def _write(self, data: bytes) -> None:
+        view = memoryview(data)
+        while view:  # a regular file takes it whole; the loop covers short writes
+            view = view[self._fh.write(view) :]
 
     def close(self) -> list[Path]:
         """Close the CSV (and write the Parquet copy); returns the files written."""

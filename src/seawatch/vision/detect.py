@@ -1914,12 +1914,12 @@ def _line_values(
 
 
 def _distinct(
-    rows: NDArray, polarity: NDArray | None = None, overlap: float = 0.7, wl_tol: float = 0.5
+    rows: NDArray, polarity: NDArray, overlap: float = 0.7, wl_tol: float = 0.5
 ) -> NDArray[np.intp]:
     """Indices (in the given order) of the detections (rows of :data:`DETECTION_COLUMNS`)
     that are no part of another: taken largest box first, a detection is dropped when
     more than ``overlap`` of its box lies inside a kept box of a shared ``polarity``
-    (bits: 1 bright, 2 dark; None: all shared) and its water line is not more than
+    (bits: 1 bright, 2 dark, per row) and its water line is not more than
     ``wl_tol`` [px] below that one's (two candidates that refined to one ship, or a
     superstructure boxed alone; a ship in front of another has its own, lower, water
     line and stays, and so does a dark hull inside a bright glint path's box)."""
@@ -1937,7 +1937,7 @@ def _distinct(
                 and ih > 0
                 and iw * ih > overlap * w * h
                 and rows[i, 6] <= rows[j, 6] + wl_tol
-                and (polarity is None or polarity[i] & polarity[j])
+                and polarity[i] & polarity[j]
             ):
                 dup = True
                 break
