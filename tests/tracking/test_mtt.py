@@ -423,3 +423,125 @@ def test_confirmed_first_keeps_a_detection_for_the_confirmed_track():
         got[cascade] = dict(zip(st.ids.tolist(), st.detection.tolist(), strict=True))
     assert got[False] == {1: -1, 2: 0}
     assert got[True] == {1: 0, 2: -1}
+
+
+# ------------------------------------------------------------------ occlusion
+
+
+def _meeting(frames=60):
+    """Two ships of one height on one row passing each other (centres 60 px apart at
+    frame 0, closing at 2 px/frame): A 40 × 10 px moving right, B 26 × 10 px moving
+    left. The detector sees each alone while they are apart and one box around both
+    (their union) while their boxes overlap (frames 14-46). Returns the truth boxes
+    (frames, 2, 4) and the scans."""
+    k = np.arange(frames, dtype=float)
+    a = np.column_stack([100.0 + k - 20.0, np.full(frames, 195.0), np.full(frames, 40.0),
+                         np.full(frames, 10.0)])  # fmt: skip
+    b = np.column_stack([160.0 - k - 13.0, np.full(frames, 195.0), np.full(frames, 26.0),
+                         np.full(frames, 10.0)])  # fmt: skip
+    truth = np.stack([a, b], axis=1)
+    scans = []
+    for f in range(frames):
+        p, q = truth[f, 0], truth[f, 1]
+        if p[0] + p[2] <= q[0] or q[0] + q[2] <= p[0]:  # apart
+            scans.append(truth[f].copy())
+        else:
+            lo = np.minimum(p[:2], q[:2])
+            hi = np.maximum(p[:2] + p[2:], q[:2] + q[2:])
+            scans.append(np.concatenate([lo, hi - lo])[None])
+    return truth, scans
+
+
+def _centre_errors(trk, truth, scans):
+    """Per frame and ship, the distance [px] from the truth box centre to the nearest
+    confirmed track's centre, and the ids seen."""
+    err = np.full(truth.shape[:2], np.nan)
+    ids = set()
+    for f, z in enumerate(scans):
+        st = trk.step(z).confirmed_tracks()
+        ids |= {int(i) for i in st.ids}
+        if len(st):
+            c = truth[f, :, :2] + 0.5 * truth[f, :, 2:]
+            d = np.linalg.norm(st.positions[None] - c[:, None], axis=2)
+            err[f] = d.min(axis=1)
+    return err, ids
+
+
+@pytest.mark.parametrize(
+    ("factory", "bound"),
+    [(None, 0.05), (AdaptiveFractionalKalmanFilter, 1.5)],  # the FKF's memory: a lag
+)
+def test_occlusion_keeps_each_ship_of_a_merged_box_on_its_own_outer_edge(factory, bound):
+    """While two ships are one box (frames 14-46), each track is measured by the box
+    edge on its own side with its remembered size, and B coasts while it lies inside
+    A's span (within 15 % of its width; no edge of the box is its own): both centres
+    stay within 0.05 px of the truth with the Kalman filter (1.5 px with the adaptive
+    fractional KF, whose memory lags the coasting prediction) and both ids live on.
+    Without the occlusion handling the merged box pulls the tracks to its centre."""
+    truth, scans = _meeting()
+    kw = dict(sigma_a=0.05, sigma_z=1.0, sigma_v0=5.0, delete_after=15, overlap_gate=0.5,
+              confirmed_first=True)  # fmt: skip
+    err, ids = _centre_errors(MultiTargetTracker(factory, occlusion=True, **kw), truth, scans)
+    assert ids == {1, 2}
+    assert np.nanmax(err[5:]) < bound, np.nanmax(err[5:])
+    plain, _ = _centre_errors(MultiTargetTracker(factory, occlusion=False, **kw), truth, scans)
+    assert np.nanmax(plain[5:]) > 5.0
+
+
+def test_occlusion_measures_a_ship_cut_by_the_one_in_front_by_its_free_edge():
+    """Ship A (40 px, still) is hidden from the right by B (26 px, nearer, coming in at
+    2 px/frame): A's box is its visible part, whose right edge is B's left edge. A's
+    centre comes from its free left edge and its remembered width (exact), its size is
+    not shrunk, and the pair is flagged ``anchored``. B is exact too (its left edge
+    lies inside A's span, so it is measured by its right one: the tracker does not
+    know which ship is in front)."""
+    trk = _tracker(confirm_m=1, confirm_n=1, occlusion=True, overlap_gate=0.5)
+    cut = []
+    for k in range(40):
+        bx = 200.0 - 2.0 * k
+        z = np.array([[100.0, 195.0, min(40.0, bx - 100.0), 10.0], [bx, 194.0, 26.0, 12.0]])
+        st = trk.step(z)
+        a, b = (st.ids == 1), (st.ids == 2)
+        assert st.states[a, 0] == pytest.approx(120.0, abs=1e-6)  # 100 + 40 / 2
+        assert st.boxes[a, 2] == pytest.approx(40.0, abs=1e-6)  # remembered width
+        if k >= 20:  # B's velocity (−2 px/frame) converged from 0 at its birth
+            assert st.states[b, 0] == pytest.approx(bx + 13.0, abs=0.05)
+        assert st.boxes[b, 2] == pytest.approx(26.0, abs=1e-6)
+        if bx < 140.0:
+            cut.append(bool(st.anchored[a][0]))
+    assert cut and all(cut)
+
+
+def test_occlusion_coasts_a_track_whose_box_edges_all_belong_to_another_ship():
+    """Two ships of different widths inside one box with both box edges inside the
+    other ship's span (one crossing behind the other): the box says nothing about the
+    smaller ship's horizontal position, so its track coasts (a miss) instead of
+    following an edge that is not its own; without occlusion handling it would take
+    the box."""
+    trk = _tracker(confirm_m=1, confirm_n=1, occlusion=True, overlap_gate=0.5, delete_after=5)
+    for _ in range(20):  # small ship S (20 px) in front of big ship L (60 px), inside its span
+        st = trk.step(np.array([[100.0, 190.0, 60.0, 14.0], [120.0, 200.0, 20.0, 8.0]]))
+    # one box: L's span in x, both in y; S's x edges both fall inside L's span
+    st = trk.step(np.array([[100.0, 190.0, 60.0, 18.0]]))
+    s = st.ids == 2
+    assert st.detection[s].tolist() == [-1] and st.misses[s].tolist() == [1]
+    assert st.states[s, 0] == pytest.approx(130.0, abs=1e-6)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_occlusion_changes_nothing_for_ships_that_never_touch(seed):
+    """Isolated ships (boxes never within each other's span): the occlusion handling
+    gives the very same tracks, scan by scan."""
+    rng = np.random.default_rng(seed)
+    starts = np.array([[50.0, 100.0], [300.0, 140.0], [600.0, 120.0]])
+    speeds = rng.uniform(-1.0, 1.0, (3, 2))
+    sizes = np.array([[40.0, 10.0], [26.0, 12.0], [60.0, 15.0]])
+    a = _tracker(occlusion=True, overlap_gate=0.5, confirmed_first=True)
+    b = _tracker(occlusion=False, overlap_gate=0.5, confirmed_first=True)
+    for k in range(60):
+        c = starts + k * speeds + rng.normal(0.0, 0.7, (3, 2))
+        z = np.column_stack([c - 0.5 * sizes, sizes + rng.normal(0.0, 0.5, (3, 2))])
+        sa, sb = a.step(z), b.step(z)
+        np.testing.assert_array_equal(sa.ids, sb.ids)
+        np.testing.assert_allclose(sa.states, sb.states, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(sa.boxes, sb.boxes, rtol=0, atol=1e-12)

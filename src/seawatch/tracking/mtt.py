@@ -19,6 +19,20 @@ image (pixels) or as points on the sea (metres). One scan:
    on the rows and columns that have any gated pair.
 4. **Update** assigned tracks with their detection (Kalman update, Joseph form);
    the others take a predict-only step (a miss).
+4a. **Occlusion** (boxes, ``occlusion``): a detection box may hold two ships (merged)
+   or only the visible part of one (cut by a ship in front). For a confirmed track,
+   an edge of its box is *blocked* when it lies within another confirmed track's
+   predicted span (on an axis where the two tracks' spans on the other axis
+   overlap). Both edges free: the box is the track's (centre and size measured). One
+   free edge: the centre is that edge moved inwards by half the track's remembered
+   size, and the size is kept. No free edge: the box's centre if its extent agrees
+   with the track's size; on the vertical axis the bottom edge (the water line) for
+   the nearest of the overlapping ships if it agrees with its predicted one; else the
+   pair is not used and the track coasts. Gating uses these centres, so of two ships
+   with one centre each takes the box of its own size; a track overlapping another
+   also takes its edge of a merged box that went to the other, and is not restarted
+   on a re-segmented box; a box that covers a third of two confirmed tracks starts no
+   track of its own.
 5. **Manage tracks**: an unassigned detection starts a *tentative* track
    (``x0 = [z, 0, 0]``, ``P0 = diag(σ_z², σ_z², σ_v0², σ_v0²)``); a tentative track is
    *confirmed* once it has M detections among its last N scans (M-of-N, counting its
@@ -109,6 +123,9 @@ class TrackStates:
             px; ``None`` when the detections are points.
         restarted: True where this scan restarted the track at an overlapping detection
             (``overlap_gate``), (k,); None: all False.
+        anchored: True where this scan measured the track by one edge of its detection
+            (``occlusion``): the detection's centre and size are not the track's, (k,);
+            None: all False.
     """
 
     time: float
@@ -121,6 +138,7 @@ class TrackStates:
     detection: NDArray[np.int64]
     boxes: FloatArray | None = None
     restarted: NDArray[np.bool_] | None = None
+    anchored: NDArray[np.bool_] | None = None
 
     def __len__(self) -> int:
         return int(self.ids.shape[0])
@@ -155,6 +173,7 @@ class TrackStates:
             detection=self.detection[mask],
             boxes=None if self.boxes is None else self.boxes[mask],
             restarted=None if self.restarted is None else self.restarted[mask],
+            anchored=None if self.anchored is None else self.anchored[mask],
         )
 
     def confirmed_tracks(self) -> TrackStates:
@@ -270,6 +289,13 @@ class MultiTargetTracker:
             most detections is served first, so an established track, not one born a
             few frames ago on a piece of its ship, takes a re-segmented box. False
             (default): one assignment over all tracks, the most pairs first.
+        occlusion: boxes only — occlusion handling by edge anchoring (module docstring,
+            step 4a): a confirmed track is gated and updated with the centre its box
+            gives once the box edges that lie within another confirmed track's span
+            are set aside (a box of two merged ships, a ship cut by the one in front);
+            a track whose box overlaps another's also takes its edge of a merged box
+            assigned to the other, and is not restarted by the overlap stage. False
+            (default): off.
         filter_options: extra keyword arguments for a filter class (see above).
     """
 
@@ -289,6 +315,7 @@ class MultiTargetTracker:
         size_smoothing: float = 0.3,
         overlap_gate: float | None = None,
         confirmed_first: bool = False,
+        occlusion: bool = False,
         filter_options: dict[str, Any] | None = None,
     ) -> None:
         self.dt = positive("dt", dt)
@@ -314,6 +341,7 @@ class MultiTargetTracker:
             else in_range("overlap_gate", overlap_gate, 0.0, 1.0, lo_open=True)
         )
         self.confirmed_first = bool(confirmed_first)
+        self.occlusion = bool(occlusion)
         self.filter_options = dict(filter_options or {})
         self.H = position_measurement(_DIM, 2)
         self.R = self.sigma_z**2 * np.eye(_DIM)
@@ -448,23 +476,36 @@ class MultiTargetTracker:
         self._predict(dt)
         # 2.–3. gate and assign
         boxes = sizes is not None and self.overlap_gate is not None
+        zs = None if sizes is None else sizes[valid]
+        edges = None  # tracks measured by the free edges of their boxes
+        if zs is not None and self.occlusion and np.count_nonzero(self._confirmed) >= 2:
+            edges = self._confirmed.copy()
         if self.confirmed_first:
-            rows, cols, r2, c2 = self._cascade(z, sizes[valid] if boxes else None)
+            rows, cols, r2, c2 = self._cascade(z, zs if boxes else None, zs, edges)
         else:
-            rows, cols = self._associate(z)
+            rows, cols = self._associate(z, sizes=zs, edges=edges)
+        if boxes and not self.confirmed_first:
+            r2, c2 = self._overlap_pairs(rows, cols, z, zs)  # type: ignore[arg-type]
         # 4. update assigned tracks, misses for the others
+        zu = z[cols]
+        explained = np.empty(0, np.int64)  # merged boxes of tracks in contact: no births
+        anchored = np.zeros(self.n_tracks, bool)
+        grow = np.ones((rows.size, _DIM), bool)  # axes whose size the detection updates
+        if edges is not None:
+            occ = self._occlusion(rows, cols, r2, c2, z, zs)  # type: ignore[arg-type]
+            rows, cols, r2, c2, zu, grow, explained = occ
+            anchored[rows[~grow.all(axis=1)]] = True
         assigned = np.zeros(self.n_tracks, bool)
         assigned[rows] = True
-        self._update(rows, z[cols])
+        self._update(rows, zu)
         detection = np.full(self.n_tracks, -1, np.int64)
         detection[rows] = valid[cols]
         restarted = np.zeros(self.n_tracks, bool)
         if sizes is not None and rows.size:
             s = self.size_smoothing
-            self._size[rows] += s * (sizes[valid[cols]] - self._size[rows])
+            change = s * (sizes[valid[cols]] - self._size[rows])
+            self._size[rows] += np.where(grow, change, 0.0)
         if boxes:
-            if not self.confirmed_first:
-                r2, c2 = self._overlap_pairs(rows, cols, z, sizes[valid])
             if r2.size:
                 restarted[r2] = True
                 self._restart(r2, z[c2], sizes[valid[c2]])
@@ -485,14 +526,17 @@ class MultiTargetTracker:
         self._compress(keep)
         detection = detection[keep]
         restarted = restarted[keep]
+        anchored = anchored[keep]
         free = np.ones(valid.size, bool)
         free[cols] = False
+        free[explained] = False
         births = valid[free]
         self._birth(centres[births], None if sizes is None else sizes[births])
         detection = np.concatenate([detection, births.astype(np.int64)])
         restarted = np.concatenate([restarted, np.zeros(births.size, bool)])
+        anchored = np.concatenate([anchored, np.zeros(births.size, bool)])
         self._time = t
-        return self._report(t, detection, restarted)
+        return self._report(t, detection, restarted, anchored)
 
     def run(
         self, scans: Sequence[ArrayLike | None], times: ArrayLike | None = None
@@ -545,16 +589,22 @@ class MultiTargetTracker:
         return 0.5 * (S + np.swapaxes(S, 1, 2))
 
     def _cascade(
-        self, z: FloatArray, sizes: FloatArray | None
+        self,
+        z: FloatArray,
+        sizes: FloatArray | None,
+        box_sizes: FloatArray | None = None,
+        edges: NDArray[np.bool_] | None = None,
     ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
         """The matching cascade (``confirmed_first``): the gate and the overlap stage for
-        the confirmed tracks, then both for the tentative tracks on the detections left.
-        Returns the gate's (rows, detections) and the overlap stage's."""
+        the confirmed tracks, then both for the tentative tracks on the detections left
+        (``sizes``: None without the overlap stage; ``box_sizes``, ``edges``: see
+        :meth:`_associate`). Returns the gate's (rows, detections) and the overlap
+        stage's."""
         empty = np.empty(0, np.int64)
         rows, cols, r2, c2 = [empty], [empty], [empty], [empty]
         free = np.ones(z.shape[0], bool)
         for group in (self._confirmed.copy(), ~self._confirmed):
-            r, c = self._associate(z, group, free)
+            r, c = self._associate(z, group, free, sizes=box_sizes, edges=edges)
             free[c] = False
             rows.append(r)
             cols.append(c)
@@ -571,9 +621,15 @@ class MultiTargetTracker:
         z: FloatArray,
         tracks: NDArray[np.bool_] | None = None,
         dets: NDArray[np.bool_] | None = None,
+        *,
+        sizes: FloatArray | None = None,
+        edges: NDArray[np.bool_] | None = None,
     ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """Mahalanobis gate and GNN assignment; returns (track rows, detection indices),
-        among the ``tracks`` and ``dets`` marked True (default: all).
+        among the ``tracks`` and ``dets`` marked True (default: all). A track marked in
+        ``edges`` (``occlusion``) is gated on every detection with the centre it would
+        be measured by (:meth:`_anchor`, box ``sizes``): of two ships with one centre,
+        each takes the box of its own size.
 
         Candidate pairs come from a sort-and-sweep prefilter: ``d² <= gamma`` implies
         ``|y_x|, |y_y| <= sqrt(gamma · tr S)``, so only detections within that box of a
@@ -601,7 +657,7 @@ class MultiTargetTracker:
         hi = np.searchsorted(zx, pred[:, 0] + radius, side="right")
         counts = hi - lo
         total = int(counts.sum())
-        if total == 0:
+        if total == 0 and edges is None:
             return empty, empty
         rows = np.repeat(np.arange(T), counts)
         starts = np.repeat(lo - (np.cumsum(counts) - counts), counts)
@@ -609,6 +665,16 @@ class MultiTargetTracker:
         y = z[cols] - pred[rows]
         near = np.abs(y[:, 1]) <= radius[rows]
         rows, cols, y = rows[near], cols[near], y[near]
+        if edges is not None and sizes is not None:  # these tracks: every detection
+            ct = np.flatnonzero(edges)
+            rest = ~edges[rows]
+            cr, cc = np.repeat(ct, D), np.tile(np.arange(D), ct.size)
+            za, _ = self._anchor(cr, z[cc], sizes[cc])
+            told = np.all(np.isfinite(za), axis=1)
+            cr, cc, za = cr[told], cc[told], za[told]
+            rows = np.concatenate([rows[rest], cr])
+            cols = np.concatenate([cols[rest], cc])
+            y = np.concatenate([y[rest], za - pred[cr]])
         # d² with the closed-form inverse of the 2 x 2 innovation covariances
         ar, br, dr, detr = a[rows], b[rows], d[rows], det[rows]
         d2 = (dr * y[:, 0] ** 2 - 2.0 * br * y[:, 0] * y[:, 1] + ar * y[:, 1] ** 2) / detr
@@ -661,16 +727,157 @@ class MultiTargetTracker:
             out_c.append(int(free_d[j]))
         return np.array(out_r, np.int64), np.array(out_c, np.int64)
 
-    def _overlaps(self, tracks: NDArray[np.int64], dc: FloatArray, ds: FloatArray) -> FloatArray:
-        """Overlap (intersection over the smaller area) of the predicted boxes of
-        ``tracks`` (predicted centres, smoothed sizes) with the boxes ``dc`` ± ``ds``/2."""
+    def _overlaps(
+        self, tracks: NDArray[np.int64], dc: FloatArray, ds: FloatArray, of_track: bool = False
+    ) -> FloatArray:
+        """Overlap (intersection over the smaller area; ``of_track``: over the track's
+        area) of the predicted boxes of ``tracks`` (predicted centres, smoothed sizes)
+        with the boxes ``dc`` ± ``ds``/2."""
         tc, ts = self._X[tracks, :_DIM], self._size[tracks]
         lo = np.maximum(tc[:, None] - 0.5 * ts[:, None], dc[None] - 0.5 * ds[None])
         hi = np.minimum(tc[:, None] + 0.5 * ts[:, None], dc[None] + 0.5 * ds[None])
         inter = np.prod(np.clip(hi - lo, 0.0, None), axis=2)
-        smaller = np.minimum(np.prod(ts, axis=1)[:, None], np.prod(ds, axis=1)[None])
+        area = np.prod(ts, axis=1)[:, None]
+        smaller = area if of_track else np.minimum(area, np.prod(ds, axis=1)[None])
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.where(smaller > 0.0, inter / smaller, 0.0)
+
+    def _contact(
+        self, dc: FloatArray, ds: FloatArray
+    ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+        """Confirmed tracks that may occlude each other: the predicted box (predicted
+        centre, smoothed size) overlaps another confirmed track's, or a detection
+        (boxes ``dc`` ± ``ds``/2) covers at least a third of it and of another's (one
+        box of both ships); and those detections (they start no track)."""
+        out = np.zeros(self.n_tracks, bool)
+        merged = np.zeros(dc.shape[0], bool)
+        idx = np.flatnonzero(self._confirmed)
+        if idx.size < 2:
+            return out, merged
+        c, half = self._X[idx, :_DIM], 0.5 * self._size[idx]
+        lo, hi = c - half, c + half
+        inter = np.minimum(hi[:, None], hi[None]) - np.maximum(lo[:, None], lo[None])
+        touch = np.all(inter > 0.0, axis=2)
+        np.fill_diagonal(touch, False)
+        out[idx] = touch.any(axis=1)
+        if dc.shape[0]:
+            covered = self._overlaps(idx, dc, ds, of_track=True) >= 1.0 / 3.0  # (k, D)
+            merged = covered.sum(axis=0) >= 2
+            out[idx] |= (covered & merged[None]).any(axis=1)
+        return out, merged
+
+    def _anchor(
+        self, rows: NDArray[np.int64], dc: FloatArray, ds: FloatArray
+    ) -> tuple[FloatArray, NDArray[np.bool_]]:
+        """Centres of tracks ``rows`` measured from boxes ``dc`` ± ``ds``/2, per axis, and
+        the axes on which the box gives the track's size too.
+
+        An edge of the box is *blocked* where it lies (within ``max(σ_z, 15 %)`` of the
+        track's size) inside the predicted span of another confirmed track that shares
+        the track's span on the other axis: it may be that ship's outline or the seam
+        between two merged ships. With both edges free the box is the track's own: its
+        centre and size are measured. With one free edge the centre is that edge moved
+        inwards by half the track's remembered size. With none, the box's centre where
+        its extent agrees with that size; on the vertical axis, else the bottom edge
+        (the water line) if it agrees with the predicted one and no other track's
+        predicted bottom over the track's columns is lower by more than σ_z / 2 (a
+        nearer ship, whose water line the box's bottom may be); else NaN: the box
+        does not tell where the track is (two ships crossing inside one box), and the
+        pair is not used.
+
+        Hand-written: trackers of merged blobs (e.g. Haritaoglu et al., W4, 2000)
+        measure an occluded object by its visible outer edge; no library offers it for
+        a Kalman box tracker."""
+        c, s = self._X[rows, :_DIM], self._size[rows]
+        lo, hi = dc - 0.5 * ds, dc + 0.5 * ds
+        tol = np.maximum(self.sigma_z, 0.15 * s)
+        blocked_lo = np.zeros(lo.shape, bool)
+        blocked_hi = np.zeros(hi.shape, bool)
+        nearest = np.ones(rows.size, bool)  # no ship below the track's bottom over its span
+        others = np.flatnonzero(self._confirmed)
+        if others.size:
+            oc, oh = self._X[others, :_DIM], 0.5 * self._size[others]
+            olo, ohi = (oc - oh)[None], (oc + oh)[None]  # (1, k, 2)
+            tlo, thi = (c - 0.5 * s)[:, None], (c + 0.5 * s)[:, None]  # (P, 1, 2)
+            shares = (np.minimum(thi, ohi) - np.maximum(tlo, olo) > 0.0)[..., ::-1]
+            shares &= others[None, :, None] != rows[:, None, None]
+            t = tol[:, None]
+            blocked_lo = np.any(shares & (olo - t <= lo[:, None]) & (lo[:, None] <= ohi + t), 1)
+            blocked_hi = np.any(shares & (olo - t <= hi[:, None]) & (hi[:, None] <= ohi + t), 1)
+            lower = ohi[..., 1] > thi[..., 1] + 0.5 * self.sigma_z
+            nearest = ~np.any(shares[..., 1] & lower, axis=1)
+        bottom = hi[:, 1] - 0.5 * s[:, 1]
+        edge = np.full(dc.shape, np.nan)
+        mine = nearest & (np.abs(bottom - c[:, 1]) <= tol[:, 1])
+        edge[:, 1] = np.where(mine, bottom, np.nan)
+        stuck = np.where(np.abs(ds - s) <= tol, dc, edge)
+        centre = np.where(
+            ~blocked_lo & ~blocked_hi,
+            dc,
+            np.where(~blocked_lo, lo + 0.5 * s, np.where(~blocked_hi, hi - 0.5 * s, stuck)),
+        )
+        return centre, ~blocked_lo & ~blocked_hi
+
+    def _occlusion(
+        self,
+        rows: NDArray[np.int64],
+        cols: NDArray[np.int64],
+        r2: NDArray[np.int64],
+        c2: NDArray[np.int64],
+        z: FloatArray,
+        sizes: FloatArray,
+    ) -> tuple[
+        NDArray[np.int64],
+        NDArray[np.int64],
+        NDArray[np.int64],
+        NDArray[np.int64],
+        FloatArray,
+        NDArray[np.bool_],
+        NDArray[np.int64],
+    ]:
+        """Occlusion handling (``occlusion``, module docstring step 4a) of the gate's
+        pairs ``rows, cols`` and the overlap stage's ``r2, c2``: returns the pairs to
+        update, the overlap pairs still to restart, the measured centres (confirmed
+        tracks: :meth:`_anchor`), the axes whose size the detection may update, and the
+        detections that are boxes of several tracks (:meth:`_contact`)."""
+        contact, merged = self._contact(z, sizes)
+        # a track in contact is not restarted on a re-segmented box (it coasts): the box
+        # may hold the other ship
+        keep = ~contact[r2]
+        r2, c2 = r2[keep], c2[keep]
+        # a track in contact left without a detection takes its edge of a box that
+        # covers it and reaches beyond the track that took the box (ships merged into
+        # one box), if that edge is inside its gate
+        idle = contact.copy()
+        idle[rows] = False
+        idle[r2] = False
+        t = np.flatnonzero(idle)
+        if t.size and z.shape[0]:
+            ov = self._overlaps(t, z, sizes, of_track=True)
+            if rows.size:
+                taker = rows  # the box of another ship (within σ_z) is not shared
+                tol = np.maximum(self.sigma_z, 0.15 * self._size[taker])
+                lo = self._X[taker, :_DIM] - 0.5 * self._size[taker] - tol
+                hi = self._X[taker, :_DIM] + 0.5 * self._size[taker] + tol
+                dc, dh = z[cols], 0.5 * sizes[cols]
+                inside = np.all((dc - dh >= lo) & (dc + dh <= hi), axis=1)
+                ov[:, cols[inside]] = 0.0
+            best = np.argmax(ov, axis=1)
+            ok = ov[np.arange(t.size), best] >= (self.overlap_gate or 0.5)
+            t, best = t[ok], best[ok]
+            if t.size:
+                za, _ = self._anchor(t, z[best], sizes[best])
+                S = self._innovation_covariance()[t]
+                y = za - self._X[t] @ self.H.T
+                d2 = np.einsum("ai,ai->a", y, np.linalg.solve(S, y[..., None])[..., 0])
+                inside = d2 <= self.gate  # False for NaN: the box does not tell
+                rows = np.concatenate([rows, t[inside]])
+                cols = np.concatenate([cols, best[inside]])
+        zu, free = self._anchor(rows, z[cols], sizes[cols])
+        mine = self._confirmed[rows][:, None]
+        zu, free = np.where(mine, zu, z[cols]), np.where(mine, free, True)
+        told = np.all(np.isfinite(zu), axis=1)  # a box that does not tell: a miss
+        return rows[told], cols[told], r2, c2, zu[told], free[told], np.flatnonzero(merged)
 
     def _restart(self, rows: NDArray[np.int64], z: FloatArray, sizes: FloatArray) -> None:
         """Restart tracks ``rows`` at detections ``z`` with their velocity and id kept:
@@ -750,7 +957,11 @@ class MultiTargetTracker:
         self._size = np.concatenate([self._size, size])
 
     def _report(
-        self, t: float, detection: NDArray[np.int64], restarted: NDArray[np.bool_] | None = None
+        self,
+        t: float,
+        detection: NDArray[np.int64],
+        restarted: NDArray[np.bool_] | None = None,
+        anchored: NDArray[np.bool_] | None = None,
     ) -> TrackStates:
         boxes = None
         if self._boxes:
@@ -766,6 +977,7 @@ class MultiTargetTracker:
             detection=detection,
             boxes=boxes,
             restarted=restarted,
+            anchored=anchored,
         )
 
 

@@ -111,6 +111,10 @@ class VisualTracker:
         confirmed_first: the matching cascade of the tracker (confirmed tracks are
             assigned before tentative ones): a track born on a fragment of a ship cannot
             take the ship from its confirmed track.
+        occlusion: occlusion handling of the tracker (:class:`~seawatch.tracking.mtt.
+            MultiTargetTracker`): while two confirmed ships' boxes overlap, each is
+            measured by the edge of its detection nearest its own, with its remembered
+            size (a box of both ships, a ship cut by the one in front).
         min_score: detections with a lower score are ignored.
         horizon: estimate the horizon per frame and give it to the detector (sea region).
         fps: frame rate used when frames come without times [1/s].
@@ -137,6 +141,7 @@ class VisualTracker:
         size_smoothing: float = 0.3,
         overlap_gate: float | None = 0.5,
         confirmed_first: bool = True,
+        occlusion: bool = True,
         min_score: float = 0.0,
         horizon: bool = True,
         fps: float = 25.0,
@@ -175,6 +180,7 @@ class VisualTracker:
             size_smoothing=size_smoothing,
             overlap_gate=overlap_gate,
             confirmed_first=confirmed_first,
+            occlusion=occlusion,
             filter_options=opts or None,
         )
         self._factory = factory
@@ -345,6 +351,8 @@ class VisualTracker:
             off = det[j, 5:7] - c
             if not np.all(np.isfinite(off)):
                 continue
+            if st.anchored is not None and st.anchored[i]:
+                continue  # measured by one edge: the box's water line may be another ship's
             prev = self._offsets.get(tid)
             if st.restarted is not None and st.restarted[i]:
                 prev = None  # a re-segmented box: its own water-line offset from now on
