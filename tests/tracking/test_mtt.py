@@ -545,3 +545,21 @@ def test_occlusion_changes_nothing_for_ships_that_never_touch(seed):
         np.testing.assert_array_equal(sa.ids, sb.ids)
         np.testing.assert_allclose(sa.states, sb.states, rtol=0, atol=1e-12)
         np.testing.assert_allclose(sa.boxes, sb.boxes, rtol=0, atol=1e-12)
+
+
+def test_occlusion_a_wake_speck_on_a_ship_does_not_freeze_the_ship_s_size():
+    """A ship approaching (its box 120 × 100 px growing 2 px a frame) with a 30 × 7 px
+    wake track at its stern inside the box's corner (under a tenth of its area): the
+    wake blocks none of the ship's edges, so the ship's box size keeps following the
+    detections (rendered uav-sea clip: the ship's size froze at 183 × 160 px while its
+    box grew to 216 × 178)."""
+    trk = _tracker(confirm_m=1, confirm_n=1, occlusion=True, overlap_gate=0.5)
+    for k in range(30):
+        w, h = 120.0 + 2.0 * k, 100.0 + 2.0 * k
+        ship = [400.0 - 0.5 * w, 300.0 - 0.5 * h, w, h]
+        wake = [400.0 + 0.5 * w - 35.0, 300.0 + 0.5 * h - 9.0, 30.0, 7.0]
+        st = trk.step(np.array([ship, wake]))
+    assert sorted(int(i) for i in st.ids) == [1, 2]
+    # exponential smoothing (0.3) of a ramp of 2 px/frame lags by 2 (1 - 0.3) / 0.3 px
+    assert st.boxes[st.ids == 1, 2][0] == pytest.approx(w - 2.0 * 0.7 / 0.3, abs=0.5)
+    assert st.boxes[st.ids == 1, 3][0] == pytest.approx(h - 2.0 * 0.7 / 0.3, abs=0.5)

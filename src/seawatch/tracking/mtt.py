@@ -19,20 +19,20 @@ image (pixels) or as points on the sea (metres). One scan:
    on the rows and columns that have any gated pair.
 4. **Update** assigned tracks with their detection (Kalman update, Joseph form);
    the others take a predict-only step (a miss).
-4a. **Occlusion** (boxes, ``occlusion``): a detection box may hold two ships (merged)
-   or only the visible part of one (cut by a ship in front). For a confirmed track,
-   an edge of its box is *blocked* when it lies within another confirmed track's
-   predicted span (on an axis where the two tracks' spans on the other axis
-   overlap). Both edges free: the box is the track's (centre and size measured). One
-   free edge: the centre is that edge moved inwards by half the track's remembered
-   size, and the size is kept. No free edge: the box's centre if its extent agrees
-   with the track's size; on the vertical axis the bottom edge (the water line) for
-   the nearest of the overlapping ships if it agrees with its predicted one; else the
-   pair is not used and the track coasts. Gating uses these centres, so of two ships
-   with one centre each takes the box of its own size; a track overlapping another
-   also takes its edge of a merged box that went to the other, and is not restarted
-   on a re-segmented box; a box that covers a third of two confirmed tracks starts no
-   track of its own.
+4a. **Occlusion** (boxes, ``occlusion``): a detection box may hold two ships (merged) or
+   only the visible part of one (cut by a ship in front). For a confirmed track, an edge
+   of its box is *blocked* when it lies within another confirmed track's predicted span
+   (on an axis where the two tracks' spans on the other axis overlap; a track of under a
+   tenth of its area blocks nothing). Both edges free: the box is the track's (centre
+   and size measured). One free edge: the centre is that edge moved inwards by half the
+   track's remembered size, and the size is kept. No free edge: the box's centre if its
+   extent agrees with the track's size; on the vertical axis the bottom edge (the water
+   line) for the nearest of the overlapping ships if it agrees with its predicted one;
+   else the pair is not used and the track coasts. Gating uses these centres, so of two
+   ships with one centre each takes the box of its own size; a track overlapping another
+   (their predicted boxes, widened by the tolerance, overlap) also takes its edge of a
+   merged box that went to the other, and is not restarted on a re-segmented box; a box
+   that covers a third of two such tracks starts no track of its own.
 5. **Manage tracks**: an unassigned detection starts a *tentative* track
    (``x0 = [z, 0, 0]``, ``P0 = diag(σ_z², σ_z², σ_v0², σ_v0²)``); a tentative track is
    *confirmed* once it has M detections among its last N scans (M-of-N, counting its
@@ -745,25 +745,27 @@ class MultiTargetTracker:
     def _contact(
         self, dc: FloatArray, ds: FloatArray
     ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
-        """Confirmed tracks that may occlude each other: the predicted box (predicted
-        centre, smoothed size) overlaps another confirmed track's, or a detection
-        (boxes ``dc`` ± ``ds``/2) covers at least a third of it and of another's (one
-        box of both ships); and those detections (they start no track)."""
+        """Confirmed tracks that may occlude each other: their predicted boxes (predicted
+        centre, smoothed size), each widened by its tolerance ``max(σ_z, 15 %)`` of its
+        size, overlap; and the detections (boxes ``dc`` ± ``ds``/2) that cover at least
+        a third of two such tracks (one box of both ships: it starts no track)."""
         out = np.zeros(self.n_tracks, bool)
         merged = np.zeros(dc.shape[0], bool)
         idx = np.flatnonzero(self._confirmed)
         if idx.size < 2:
             return out, merged
-        c, half = self._X[idx, :_DIM], 0.5 * self._size[idx]
+        c, s = self._X[idx, :_DIM], self._size[idx]
+        half = 0.5 * s + np.maximum(self.sigma_z, 0.15 * s)
         lo, hi = c - half, c + half
         inter = np.minimum(hi[:, None], hi[None]) - np.maximum(lo[:, None], lo[None])
         touch = np.all(inter > 0.0, axis=2)
         np.fill_diagonal(touch, False)
         out[idx] = touch.any(axis=1)
-        if dc.shape[0]:
+        if dc.shape[0] and out.any():
             covered = self._overlaps(idx, dc, ds, of_track=True) >= 1.0 / 3.0  # (k, D)
-            merged = covered.sum(axis=0) >= 2
-            out[idx] |= (covered & merged[None]).any(axis=1)
+            # detection d covers tracks a and b that touch
+            pair = covered[:, None, :] & covered[None, :, :] & touch[:, :, None]
+            merged = pair.any(axis=(0, 1))
         return out, merged
 
     def _anchor(
@@ -774,16 +776,17 @@ class MultiTargetTracker:
 
         An edge of the box is *blocked* where it lies (within ``max(σ_z, 15 %)`` of the
         track's size) inside the predicted span of another confirmed track that shares
-        the track's span on the other axis: it may be that ship's outline or the seam
-        between two merged ships. With both edges free the box is the track's own: its
-        centre and size are measured. With one free edge the centre is that edge moved
-        inwards by half the track's remembered size. With none, the box's centre where
-        its extent agrees with that size; on the vertical axis, else the bottom edge
-        (the water line) if it agrees with the predicted one and no other track's
-        predicted bottom over the track's columns is lower by more than σ_z / 2 (a
-        nearer ship, whose water line the box's bottom may be); else NaN: the box
-        does not tell where the track is (two ships crossing inside one box), and the
-        pair is not used.
+        the track's span on the other axis and has at least a tenth of its area
+        (:data:`_RESTART_GROWTH`; a wake or glint speck beside a ship blocks nothing):
+        it may be that ship's outline or the seam between two merged ships. With both
+        edges free the box is the track's own: its centre and size are measured. With
+        one free edge the centre is that edge moved inwards by half the track's
+        remembered size. With none, the box's centre where its extent agrees with that
+        size; on the vertical axis, else the bottom edge (the water line) if it agrees
+        with the predicted one and no other track's predicted bottom over the track's
+        columns is lower by more than σ_z / 2 (a nearer ship, whose water line the box's
+        bottom may be); else NaN: the box does not tell where the track is (two ships
+        crossing inside one box), and the pair is not used.
 
         Hand-written: trackers of merged blobs (e.g. Haritaoglu et al., W4, 2000)
         measure an occluded object by its visible outer edge; no library offers it for
@@ -802,6 +805,9 @@ class MultiTargetTracker:
             shares = (np.minimum(thi, ohi) - np.maximum(tlo, olo) > 0.0)[..., ::-1]
             shares &= others[None, :, None] != rows[:, None, None]
             t = tol[:, None]
+            area = np.prod(s, axis=1)[:, None]
+            oarea = np.prod(self._size[others], axis=1)[None]
+            shares &= (oarea * _RESTART_GROWTH > area)[..., None]  # not a speck on a ship
             blocked_lo = np.any(shares & (olo - t <= lo[:, None]) & (lo[:, None] <= ohi + t), 1)
             blocked_hi = np.any(shares & (olo - t <= hi[:, None]) & (hi[:, None] <= ohi + t), 1)
             lower = ohi[..., 1] > thi[..., 1] + 0.5 * self.sigma_z
