@@ -123,9 +123,10 @@ class TrackStates:
             px; ``None`` when the detections are points.
         restarted: True where this scan restarted the track at an overlapping detection
             (``overlap_gate``), (k,); None: all False.
-        anchored: True where this scan measured the track by one edge of its detection
-            (``occlusion``): the detection's centre and size are not the track's, (k,);
-            None: all False.
+        anchored: True where this scan measured the track with a box not wholly its
+            own (``occlusion``: an edge of it lay in another track's span), so that the
+            box's centre, size and water line are not the track's, (k,); None: all
+            False.
     """
 
     time: float
@@ -603,8 +604,8 @@ class MultiTargetTracker:
         empty = np.empty(0, np.int64)
         rows, cols, r2, c2 = [empty], [empty], [empty], [empty]
         free = np.ones(z.shape[0], bool)
-        for group in (self._confirmed.copy(), ~self._confirmed):
-            r, c = self._associate(z, group, free, sizes=box_sizes, edges=edges)
+        for group, by_edges in ((self._confirmed.copy(), edges), (~self._confirmed, None)):
+            r, c = self._associate(z, group, free, sizes=box_sizes, edges=by_edges)
             free[c] = False
             rows.append(r)
             cols.append(c)
@@ -861,7 +862,7 @@ class MultiTargetTracker:
         if t.size and z.shape[0]:
             ov = self._overlaps(t, z, sizes, of_track=True)
             if rows.size:
-                taker = rows  # the box of another ship (within σ_z) is not shared
+                taker = rows  # a box within the tolerance of its taker's is not shared
                 tol = np.maximum(self.sigma_z, 0.15 * self._size[taker])
                 lo = self._X[taker, :_DIM] - 0.5 * self._size[taker] - tol
                 hi = self._X[taker, :_DIM] + 0.5 * self._size[taker] + tol
