@@ -573,3 +573,23 @@ def test_occlusion_a_wake_speck_on_a_ship_does_not_freeze_the_ship_s_size():
     # exponential smoothing (0.3) of a ramp of 2 px/frame lags by 2 (1 - 0.3) / 0.3 px
     assert st.boxes[st.ids == 1, 2][0] == pytest.approx(w - 2.0 * 0.7 / 0.3, abs=0.5)
     assert st.boxes[st.ids == 1, 3][0] == pytest.approx(h - 2.0 * 0.7 / 0.3, abs=0.5)
+
+
+def test_occlusion_with_degenerate_boxes_keeps_finite_states():
+    """Zero-width and zero-height boxes beside and inside a ship's box (a detector's
+    degenerate output) with the occlusion handling on: every state stays finite and
+    the ship keeps its id."""
+    trk = _tracker(confirm_m=1, confirm_n=1, occlusion=True, overlap_gate=0.5)
+    for k in range(15):
+        z = np.array(
+            [
+                [100.0 + k, 200.0, 40.0, 10.0],
+                [110.0 + k, 202.0, 0.0, 6.0],  # zero width, inside the ship
+                [150.0 + k, 200.0, 8.0, 0.0],  # zero height, beside it
+                [100.0 + k, 212.0, 0.0, 0.0],  # a point
+            ]
+        )
+        st = trk.step(z)
+        assert np.all(np.isfinite(st.states)) and np.all(np.isfinite(st.boxes))
+    ship = np.flatnonzero(st.ids == 1)
+    assert ship.size == 1 and st.states[ship[0], 0] == pytest.approx(134.0, abs=0.5)
