@@ -112,9 +112,10 @@ class VisualTracker:
             assigned before tentative ones): a track born on a fragment of a ship cannot
             take the ship from its confirmed track.
         occlusion: occlusion handling of the tracker (:class:`~seawatch.tracking.mtt.
-            MultiTargetTracker`): while two confirmed ships' boxes overlap, each is
-            measured by the edge of its detection nearest its own, with its remembered
-            size (a box of both ships, a ship cut by the one in front).
+            MultiTargetTracker`, step 4a): where confirmed ships' boxes overlap, each is
+            measured by the edges of its detection that lie outside the other ships'
+            spans, with its remembered size (a box of both ships, a ship cut by the one
+            in front); its water-line offset is then not updated.
         min_score: detections with a lower score are ignored.
         horizon: estimate the horizon per frame and give it to the detector (sea region).
         fps: frame rate used when frames come without times [1/s].
@@ -352,7 +353,7 @@ class VisualTracker:
             if not np.all(np.isfinite(off)):
                 continue
             if st.anchored is not None and st.anchored[i]:
-                continue  # measured by one edge: the box's water line may be another ship's
+                continue  # a box not wholly its own: its water line may be another ship's
             prev = self._offsets.get(tid)
             if st.restarted is not None and st.restarted[i]:
                 prev = None  # a re-segmented box: its own water-line offset from now on
