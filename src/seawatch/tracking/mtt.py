@@ -81,6 +81,9 @@ _RESTART_GROWTH = 10.0
 """Largest ratio of a detection's box area to a track's for the overlap stage's restart
 (a hull that gains its superstructure: a few times; a boat merged into the box of the
 ships passing in front of it: tens of times)."""
+_EDGE_TOL = 0.15
+"""Occlusion handling: a box edge within this fraction of a track's size (at least σ_z)
+of a span or an extent counts as on it (:meth:`MultiTargetTracker._tolerance`)."""
 _UNGATED = 1.0e12  # cost of a pair outside the gate inside the assignment solver
 
 
@@ -234,6 +237,14 @@ def _assign_pairs(
 # --------------------------------------------------------------------------------------
 # the tracker
 # --------------------------------------------------------------------------------------
+
+
+def _mahalanobis2(S: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """``d² = yᵀ S⁻¹ y`` of 2-vectors ``y`` (n, 2) with 2 × 2 covariances ``S`` (n, 2, 2),
+    by the closed-form inverse, and ``det S`` (n,)."""
+    a, b, d = S[:, 0, 0], S[:, 0, 1], S[:, 1, 1]
+    det = a * d - b * b
+    return (d * y[:, 0] ** 2 - 2.0 * b * y[:, 0] * y[:, 1] + a * y[:, 1] ** 2) / det, det
 
 
 def _count(name: str, value: int, minimum: int) -> int:
@@ -677,8 +688,7 @@ class MultiTargetTracker:
             cols = np.concatenate([cols[rest], cc])
             y = np.concatenate([y[rest], za - pred[cr]])
         # d² with the closed-form inverse of the 2 x 2 innovation covariances
-        ar, br, dr, detr = a[rows], b[rows], d[rows], det[rows]
-        d2 = (dr * y[:, 0] ** 2 - 2.0 * br * y[:, 0] * y[:, 1] + ar * y[:, 1] ** 2) / detr
+        d2, detr = _mahalanobis2(S[rows], y)
         gated = d2 <= self.gate
         if tracks is not None:
             gated &= tracks[rows]
@@ -743,6 +753,11 @@ class MultiTargetTracker:
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.where(smaller > 0.0, inter / smaller, 0.0)
 
+    def _tolerance(self, size: FloatArray) -> FloatArray:
+        """How near [px or m] a box edge must come to a span or an extent to count as
+        on it, per axis of ``size``: ``max(σ_z, 15 %)`` of the size (:data:`_EDGE_TOL`)."""
+        return np.maximum(self.sigma_z, _EDGE_TOL * size)
+
     def _contact(
         self, dc: FloatArray, ds: FloatArray
     ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
@@ -756,7 +771,7 @@ class MultiTargetTracker:
         if idx.size < 2:
             return out, merged
         c, s = self._X[idx, :_DIM], self._size[idx]
-        half = 0.5 * s + np.maximum(self.sigma_z, 0.15 * s)
+        half = 0.5 * s + self._tolerance(s)
         lo, hi = c - half, c + half
         inter = np.minimum(hi[:, None], hi[None]) - np.maximum(lo[:, None], lo[None])
         touch = np.all(inter > 0.0, axis=2)
@@ -794,7 +809,7 @@ class MultiTargetTracker:
         a Kalman box tracker."""
         c, s = self._X[rows, :_DIM], self._size[rows]
         lo, hi = dc - 0.5 * ds, dc + 0.5 * ds
-        tol = np.maximum(self.sigma_z, 0.15 * s)
+        tol = self._tolerance(s)
         blocked_lo = np.zeros(lo.shape, bool)
         blocked_hi = np.zeros(hi.shape, bool)
         nearest = np.ones(rows.size, bool)  # no ship below the track's bottom over its span
@@ -863,7 +878,7 @@ class MultiTargetTracker:
             ov = self._overlaps(t, z, sizes, of_track=True)
             if rows.size:
                 taker = rows  # a box within the tolerance of its taker's is not shared
-                tol = np.maximum(self.sigma_z, 0.15 * self._size[taker])
+                tol = self._tolerance(self._size[taker])
                 lo = self._X[taker, :_DIM] - 0.5 * self._size[taker] - tol
                 hi = self._X[taker, :_DIM] + 0.5 * self._size[taker] + tol
                 dc, dh = z[cols], 0.5 * sizes[cols]
@@ -874,9 +889,8 @@ class MultiTargetTracker:
             t, best = t[ok], best[ok]
             if t.size:
                 za, _ = self._anchor(t, z[best], sizes[best])
-                S = self._innovation_covariance()[t]
                 y = za - self._X[t] @ self.H.T
-                d2 = np.einsum("ai,ai->a", y, np.linalg.solve(S, y[..., None])[..., 0])
+                d2, _ = _mahalanobis2(self._innovation_covariance()[t], y)
                 inside = d2 <= self.gate  # False for NaN: the box does not tell
                 rows = np.concatenate([rows, t[inside]])
                 cols = np.concatenate([cols, best[inside]])

@@ -348,12 +348,12 @@ class VisualTracker:
             j = int(st.detection[i])
             if j < 0 or j >= det.shape[0]:
                 continue
+            if st.anchored is not None and st.anchored[i]:
+                continue  # a box not wholly its own: its water line may be another ship's
             c = det[j, :2] + 0.5 * det[j, 2:4]
             off = det[j, 5:7] - c
             if not np.all(np.isfinite(off)):
                 continue
-            if st.anchored is not None and st.anchored[i]:
-                continue  # a box not wholly its own: its water line may be another ship's
             prev = self._offsets.get(tid)
             if st.restarted is not None and st.restarted[i]:
                 prev = None  # a re-segmented box: its own water-line offset from now on
