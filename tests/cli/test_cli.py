@@ -100,6 +100,8 @@ def test_experiment_json_has_the_interfaces_shape(tmp_path):
         ["experiment", "no-such-paper"],
         ["experiment", "air-range", "--table", "2"],
         ["experiment", "air-range", "--fov", "30"],
+        ["experiment", "air-range", "--crf", "0"],
+        ["experiment", "ship-video", "--crf", "60"],
     ],
 )
 def test_experiment_bad_name_or_option_is_exit_2(args):

@@ -27,6 +27,7 @@ def test_record_shapes_and_sweep(tmp_path):
     assert set(res.extra["ordering"]) == {"small"}
     assert res.extra["best_order"] in (0.8, 1.0)
     assert (tmp_path / "cle.csv").exists() and (tmp_path / "small" / "video.mp4").exists()
+    assert res.extra["crf"] == 20
 
 
 def test_bad_arguments_raise():
@@ -34,6 +35,9 @@ def test_bad_arguments_raise():
         run(cases=["tiny"])
     with pytest.raises(ValueError, match="runs"):
         run(runs=0)
+    for crf in (-1, 52, 1.5):
+        with pytest.raises(ValueError, match="crf"):
+            run(cases=["large"], crf=crf)
 
 
 def test_chunked_units_give_the_records_of_one_run(tmp_path):

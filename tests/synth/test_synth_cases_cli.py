@@ -85,7 +85,7 @@ def test_cli_renders_a_case_and_prints_a_json_summary(tmp_path: Path) -> None:
     assert (doc["width"], doc["height"]) == (320, 180)
     for key in ("video", "camera", "truth", "horizon"):
         assert Path(doc["outputs"][key]).is_file()
-    assert doc["truth_rows"] == 4 and math.isfinite(doc["render_fps"])
+    assert doc["truth_rows"] == 4 and math.isfinite(doc["render_fps"]) and doc["crf"] == 20
     lines = Path(doc["outputs"]["horizon"]).read_text().splitlines()
     assert len(lines) == 5
 
@@ -99,7 +99,7 @@ def test_cli_bad_case_exits_2_naming_the_option(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize(
-    ("opt", "value"), [("--width", "321"), ("--duration", "0"), ("--fps", "-5")]
+    ("opt", "value"), [("--width", "321"), ("--duration", "0"), ("--fps", "-5"), ("--crf", "52")]
 )
 def test_cli_bad_numbers_exit_2(tmp_path: Path, opt: str, value: str) -> None:
     args = ["synth", "ship-video", "--case", "small", "--out", str(tmp_path), opt, value]

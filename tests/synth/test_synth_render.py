@@ -294,6 +294,23 @@ def test_video_reads_back_with_the_right_frame_count_size_and_pixels(tmp_path: P
     assert loaded.image_size == (320, 180) and math.isclose(loaded.height, 12.0)
 
 
+def test_crf_0_is_lossless_and_a_higher_crf_is_not(tmp_path: Path) -> None:
+    """libx264's crf 0 is lossless: the decoded I420 planes are the rendered ones, bit for
+    bit (what ``seawatch experiment ship-video --crf 0`` relies on to isolate the
+    compression's share of the error); crf 30 changes pixels."""
+    cam = PinholeCamera.from_fov(320, 180, 50.0, height=12.0)
+    n0, e0 = _ahead(cam, 600.0, 0.0)
+    ship = make_ship(1, straight(n0, e0, 1.5, 5.0, 5.0), 40.0)
+    expect = [Renderer(cam, [ship], 10.0, seed=4).frame(i).yuv for i in range(3)]
+    for crf in (0, 30):
+        res = render(cam, [ship], 0.3, 10.0, out_dir=tmp_path / str(crf), seed=4, crf=crf)
+        with av.open(str(res.video)) as container:
+            got = [f.to_ndarray(format="yuv420p") for f in container.decode(video=0)]
+        assert len(got) == 3
+        same = [np.array_equal(g, e) for g, e in zip(got, expect, strict=True)]
+        assert all(same) if crf == 0 else not any(same), (crf, same)
+
+
 def test_truth_and_horizon_files_grow_while_rendering(tmp_path: Path) -> None:
     cam = PinholeCamera.from_fov(320, 180, 50.0, height=12.0)
     n0, e0 = _ahead(cam, 500.0, 0.0)
@@ -334,3 +351,6 @@ def test_bad_inputs_raise_value_errors_naming_the_argument(tmp_path: Path) -> No
         render(good, [ship], 0.2, 10.0, out_dir=blocker / "sub")
     with pytest.raises(ValueError, match="duration"):
         render(good, [ship], -1.0, 10.0, out_dir=tmp_path)
+    for crf in (-1, 52, 2.5, True):
+        with pytest.raises(ValueError, match="crf"):
+            render(good, [ship], 0.2, 10.0, out_dir=tmp_path, crf=crf)  # type: ignore[arg-type]

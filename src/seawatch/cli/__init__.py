@@ -139,6 +139,13 @@ def experiment(
     fov: Annotated[
         float | None, typer.Option(help="solent-ais: horizontal field of view (deg).")
     ] = None,
+    crf: Annotated[
+        int | None,
+        typer.Option(
+            help="ship-video: libx264 quality of the rendered footage, 0 (lossless) … 51 "
+            "(default 20).",
+        ),
+    ] = None,
     workers: Annotated[
         int | None,
         typer.Option(help="Dask worker processes (default: the machine's cores).", min=1),
@@ -177,6 +184,7 @@ def experiment(
             "camera_height": camera_height,
             "camera_heading": camera_heading,
             "fov": fov,
+            "crf": crf,
         }
         accepted = registry.options(name)
         for key, value in scenario_options.items():

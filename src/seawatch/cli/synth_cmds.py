@@ -55,6 +55,9 @@ def ship_video(
     width: Annotated[int, typer.Option(help="Image width [px] (even).")] = 1920,
     height: Annotated[int, typer.Option(help="Image height [px] (even).")] = 1080,
     seed: Annotated[int, typer.Option(help="Random seed (waves, clouds, noise).")] = 0,
+    crf: Annotated[
+        int, typer.Option(help="libx264 quality: 0 (lossless) … 51; lower is better.")
+    ] = 20,
     json_out: Annotated[
         bool, typer.Option("--json", help="Print a JSON summary on stdout.")
     ] = False,
@@ -82,6 +85,8 @@ def ship_video(
         for name, value in (("--width", width), ("--height", height)):
             if value < 16 or value % 2:
                 raise BadInput(f"{name}: expected an even number of pixels >= 16, got {value}")
+        if not 0 <= crf <= 51:
+            raise BadInput(f"--crf: expected an integer in 0 … 51 (libx264), got {crf}")
         info = ship_video_case(case, duration=duration, width=width, height=height, seed=seed)
         with progress_bar() as bar:
             task = bar.add_task(f"synth {case}", total=max(1, round(duration * fps)))
@@ -94,12 +99,14 @@ def ship_video(
                 height=height,
                 seed=seed,
                 progress=lambda done, total: bar.update(task, completed=done, total=total),
+                crf=crf,
             )
         doc = {
             "case": case,
             "description": info.description,
             "lighting": info.lighting.name,
             "seed": seed,
+            "crf": crf,
             **result.to_json(),
         }
         if json_out:

@@ -128,8 +128,11 @@ def _unit_options(
     orders: Sequence[float],
     small_scale: int,
     fps: float,
+    crf: int,
 ) -> dict[str, Any]:
     """The rendering and sweep options of :func:`_unit`, checked."""
+    if isinstance(crf, bool) or not isinstance(crf, int) or not 0 <= crf <= 51:
+        raise ValueError(f"crf: expected an integer in 0 … 51 (libx264), got {crf!r}")
     return {
         "width": width,
         "height": height,
@@ -137,6 +140,7 @@ def _unit_options(
         "orders": _orders(orders),
         "small_scale": small_scale,
         "fps": fps,
+        "crf": crf,
     }
 
 
@@ -157,6 +161,7 @@ def _unit(
     orders: list[float],
     small_scale: int,
     fps: float,
+    crf: int,
 ) -> dict[str, Any]:
     """Render (into ``folder``), detect and track unit ``u`` (:func:`_case`); rows
     ``(estimator, order, cle_px, cle_percent, precision)`` with order None except in the
@@ -164,7 +169,14 @@ def _unit(
     r, name = _case(u, names)
     k = small_scale if name == SWEEP_CASE else 1
     res = render_case(
-        name, folder, duration=duration, fps=fps, width=width * k, height=height * k, seed=seed + r
+        name,
+        folder,
+        duration=duration,
+        fps=fps,
+        width=width * k,
+        height=height * k,
+        seed=seed + r,
+        crf=crf,
     )
     dets = detect_video(res.video, VisualTracker(fps=fps))
     truth = read_truth(res.truth)
@@ -176,7 +188,7 @@ def _unit(
         for a in orders:
             c = track_case(dets, truth, "afkf", order=a)
             rows.append(("afkf", a, c.mean_px, c.mean_percent, c.precision))
-    return {"run": r, "case": name, "rows": rows}
+    return {"run": r, "case": name, "crf": crf, "rows": rows}
 
 
 _HEADER = ["case", "run", "estimator", "order", "cle_px", "cle_percent", "precision"]
@@ -202,6 +214,7 @@ def run(
     orders: Sequence[float] = ORDERS,
     small_scale: int = 2,
     fps: float = 25.0,
+    crf: int = 20,
 ) -> ExperimentResult:
     """Run the ship-video experiment (module docstring).
 
@@ -216,6 +229,9 @@ def run(
         width, height: frame size [px] (the small case: ``small_scale`` times it).
         duration: clip length [s]; fps: frame rate [1/s].
         orders: fractional orders of the AFKF sweep on the small case (when it is run).
+        crf: libx264 quality of the rendered footage (0–51; default 20, as the
+            ``seawatch synth`` clips; 0 is lossless, which isolates the error of the
+            detector and tracker from the compression's).
 
     Returns:
         :class:`ExperimentResult` with records ``cle_px``, ``cle_percent``,
@@ -225,7 +241,7 @@ def run(
     """
     n_runs = _runs(runs)
     names = _names(cases)
-    opts = _unit_options(width, height, duration, orders, small_scale, fps)
+    opts = _unit_options(width, height, duration, orders, small_scale, fps, crf)
     with contextlib.ExitStack() as stack:
         if out_dir is None:
             root = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="seawatch-sv-")))
@@ -264,12 +280,13 @@ def chunk(
     orders: Sequence[float] = ORDERS,
     small_scale: int = 2,
     fps: float = 25.0,
+    crf: int = 20,
 ) -> list[dict[str, Any]]:
     """Units ``indices`` (run × case, see :func:`units`) of the experiment, rendered in a
     temporary folder (the parallel protocol of :mod:`seawatch.scenarios.parallel`); a
     unit's numbers depend only on (seed, run, case)."""
     names = _names(cases)
-    opts = _unit_options(width, height, duration, orders, small_scale, fps)
+    opts = _unit_options(width, height, duration, orders, small_scale, fps, crf)
     idx = [int(i) for i in indices]
     n = _runs(runs) * len(names)
     if not idx or idx != sorted(set(idx)) or idx[0] < 0 or idx[-1] >= n:
@@ -334,7 +351,7 @@ def _result(
     for name in names:
         m = [float(np.nanmean(values[(e, "cle_percent", name)])) for e in FILTERS]
         ordering[name] = bool(m[0] <= m[1] <= m[2])
-    extra: dict[str, Any] = {"ordering": ordering}
+    extra: dict[str, Any] = {"ordering": ordering, "crf": done[0]["crf"] if done else None}
     swept = {a: float(np.nanmean(v)) for a, v in sweep.items() if v}
     if swept and all(np.isfinite(list(swept.values()))):
         best = min(swept, key=lambda a: swept[a])

@@ -280,9 +280,11 @@ def render_case(
     height: int = 1080,
     seed: int = 0,
     progress: Callable[[int, int], None] | None = None,
+    crf: int = 20,
 ) -> RenderResult:
     """Render the case ``name`` into ``out_dir`` (video.mp4, camera.yaml, truth.csv,
-    horizon.csv) with :func:`seawatch.synth.render`."""
+    horizon.csv) with :func:`seawatch.synth.render` (``crf``: libx264's quality, 0
+    lossless)."""
     case = ship_video_case(name, duration=duration, width=width, height=height, seed=seed)
     return render(
         case.camera,
@@ -295,5 +297,6 @@ def render_case(
         coastline=case.coastline,
         seed=case.seed,
         progress=progress,
+        crf=crf,
         description=f"seawatch synth ship-video --case {name}: {case.description}",
     )

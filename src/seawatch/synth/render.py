@@ -1414,13 +1414,17 @@ def render(
     Writes ``video.mp4`` (H.264, yuv420p), ``camera.yaml`` (the mounting camera, via
     `seawatch.io.save_camera`), ``truth.csv`` and ``horizon.csv`` (module docstring),
     the CSVs flushed after every frame. ``progress(done, total)`` is called after each
-    frame. Other arguments as in :class:`Renderer`; ``crf``/``preset`` are libx264's.
-    Returns a :class:`RenderResult`.
+    frame. Other arguments as in :class:`Renderer`; ``crf``/``preset`` are libx264's
+    (``crf`` 0–51, lower is better; 0 is lossless: the decoded I420 frames are exactly
+    the rendered ones, so compression can be told apart from the rest of a pipeline's
+    error). Returns a :class:`RenderResult`.
     """
     from seawatch.io import save_camera
 
     d = positive("duration", duration)
     f = positive("fps", fps)
+    if isinstance(crf, bool) or not isinstance(crf, int | np.integer) or not 0 <= crf <= 51:
+        raise ValueError(f"crf: expected an integer in 0 … 51 (libx264), got {crf!r}")
     n_frames = max(1, round(d * f))
     renderer = Renderer(
         camera,
