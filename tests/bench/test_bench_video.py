@@ -8,6 +8,7 @@ closed forms (perfect tracks score perfectly; a known shift gives that CLE).
 from __future__ import annotations
 
 import math
+import os
 import sys
 
 import numpy as np
@@ -59,11 +60,19 @@ def test_tiny_run_returns_the_benchmark_json_with_positive_speeds(tiny):
             assert all(v > 0 for v in t.values())
             total = 1000.0 / by_name[k]["cpu_time_frames_per_s"]
             assert sum(t.values()) <= 1.05 * total + 1.0
-        # decoding alone runs in the calling thread (and the decoder's own threads)
-        assert "MainThread" in by_name["decode"]["thread_cpu_ms_per_frame"]
-        assert not {"seawatch-read", "seawatch-detect"} & set(
-            by_name["decode"]["thread_cpu_ms_per_frame"]
+        # decoding alone runs in the calling thread (and the decoder's own threads);
+        # /proc counts thread CPU in clock ticks (10 ms), and the fastest of the tiny
+        # clip's decodes takes about one (measured once: no thread showed at all), shared
+        # with the decoder's threads
+        dec = by_name["decode"]
+        threads = dec["thread_cpu_ms_per_frame"]
+        tick_ms = 1000.0 / os.sysconf("SC_CLK_TCK")
+        dec_cpu_ms = 1000.0 * dec["frames"] / dec["cpu_time_frames_per_s"]
+        assert "MainThread" in threads or dec_cpu_ms < 4.0 * tick_ms, (
+            threads,
+            dec_cpu_ms,
         )
+        assert not {"seawatch-read", "seawatch-detect"} & set(threads)
     for k in ("track_video", "decode+horizon+detect+track"):
         t = doc["targets"][k]
         assert t["target"] == video.SPEED_TARGET and t["met"] == (t["measured"] >= 25.0)
