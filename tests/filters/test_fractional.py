@@ -257,6 +257,38 @@ def test_missing_measurement_is_predict_only_and_history_advances():
     assert np.all(np.isfinite(f.x))
 
 
+def test_update_with_a_step_covariance_is_the_joseph_update_with_it():
+    """``update(z, R=...)``: eqs. (16)–(18) with that R for this step only; a huge variance
+    on one coordinate measured at its prediction leaves the one-coordinate update."""
+    f = FractionalKalmanFilter.for_image_tracking(x0=[100.0, 50.0, 1.0, 0.5], sigma_z=2.0)
+    for z in ([101.2, 50.3], [101.9, 51.2], [103.1, 51.4]):
+        f.step(z)
+    f.predict()
+    x_prior, P_prior, H = f.x, f.P, f.H
+    z = np.array([104.6, 52.9])
+    R2 = np.array([[1.0, 0.3], [0.3, 9.0]])
+    f.update(z, R=R2)
+    K = P_prior @ H.T @ np.linalg.inv(H @ P_prior @ H.T + R2)
+    A = np.eye(4) - K @ H
+    np.testing.assert_allclose(f.x, x_prior + K @ (z - H @ x_prior), rtol=1e-12)
+    np.testing.assert_allclose(f.P, A @ P_prior @ A.T + K @ R2 @ K.T, rtol=1e-10, atol=1e-12)
+    f.predict()  # the next update is back to the filter's own R
+    x_prior, P_prior = f.x, f.P
+    f.update(z)
+    K = P_prior @ H.T @ np.linalg.inv(H @ P_prior @ H.T + f.R)
+    np.testing.assert_allclose(f.x, x_prior + K @ (z - H @ x_prior), rtol=1e-12)
+    # x only: y measured at its prediction with a variance 1e8 σ_z²
+    f.predict()
+    x_prior, P_prior = f.x, f.P
+    f.update([106.0, (H @ x_prior)[1]], R=np.diag([4.0, 4e8]))
+    h = H[:1]
+    k = P_prior @ h.T / (h @ P_prior @ h.T + 4.0)
+    np.testing.assert_allclose(f.x, x_prior + (k * (106.0 - x_prior[0])).ravel(), rtol=1e-9)
+    for bad in (np.eye(3), np.array([[1.0, 0.5], [0.0, 1.0]]), np.diag([1.0, np.nan])):
+        with pytest.raises(ValueError, match="R"):
+            f.update(z, R=bad)
+
+
 def test_batched_filter_equals_looped_single_tracks():
     rng = np.random.default_rng(1234)
     _, zs = simulate_cv(rng, 6, 50, 0.5, 2.0)

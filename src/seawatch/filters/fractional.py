@@ -534,18 +534,31 @@ class FractionalKalmanFilter:
         s["x_prior"] = s["x"].copy()
         s["P_prior"] = s["P"].copy()
 
-    def update(self, z: ArrayLike | None) -> None:
+    def update(self, z: ArrayLike | None, R: ArrayLike | None = None) -> None:
         """Measurement update (16)–(18), Joseph form (and the Q rule of the AFKF).
 
         Args:
             z: measurement (m,) or (B..., m), absolute coordinates (px for the image
                 model); NaN in a row or ``None``: predict-only for that track. Before any
                 state exists (``x0=None``) the first z initialises the filter.
+            R: measurement covariance (m, m) for this update only (default ``self.R``),
+                e.g. a very large variance on a coordinate the measurement does not
+                tell (the update then leaves it to the prediction).
 
         Raises:
             numpy.linalg.LinAlgError: singular innovation covariance.
+            ValueError: ``R`` of the wrong shape, not finite or not symmetric.
         """
         m = self.dim_z
+        if R is None:
+            Rk = self.R
+        else:
+            Rk = np.asarray(R, dtype=np.float64)
+            if Rk.shape != (m, m) or not np.all(np.isfinite(Rk)) or not np.allclose(Rk, Rk.T):
+                raise ValueError(
+                    f"R: expected a finite symmetric ({m}, {m}) matrix, got shape {Rk.shape}"
+                )
+            Rk = np.ascontiguousarray(Rk)
         if z is None:
             self._need_state("update(None)")
             za = np.full(m, np.nan)
@@ -562,7 +575,7 @@ class FractionalKalmanFilter:
         work = {k: s[k].copy() for k in keys}
         rule, gain, g_max, delta, bounds = self._adapt_args()
         status = _fkf_update_batch(
-            self.H, self.R, zf, work["x"], work["P"], work["y"], work["S"], work["nis"],
+            self.H, Rk, zf, work["x"], work["P"], work["y"], work["S"], work["nis"],
             rule, gain, g_max, delta, bounds, work["etas"], work["astate"], work["q_scale"],
         )  # fmt: skip
         raise_kernel_status(status, batch, f"{type(self).__name__}.update")
