@@ -312,6 +312,50 @@ def test_overlap_stage_keeps_the_id_of_a_re_segmented_box_and_restarts_its_centr
     assert st.boxes[0, 3] == pytest.approx(75.0, abs=1.0)
 
 
+@pytest.mark.parametrize("factory", [None, AdaptiveFractionalKalmanFilter])
+def test_overlap_stage_keeps_a_confirmed_ships_water_line(factory):
+    """A 56 × 13 px ship moving right 0.3 px/frame; for two frames its box also holds the
+    sun glint below it (56 × 38 px, the top and sides unchanged: rendered lighting
+    case), then for two frames only its 20 × 6 px superstructure at the stern is boxed
+    (centre 16 px off, out of the gate; inside the ship's box). Neither is a
+    re-segmentation of the ship: its water line would jump 25 px down, then 7 px up
+    (tolerance max(σ_z, 15 % of 13 px) = 2 px). The track coasts, unrestarted: its centre
+    and velocity stay within 0.5 px and 0.05 px/frame, and it takes its own box again.
+    The same scans with the ship's bottom edge kept (a superstructure gained, as in the
+    re-segmentation test above) do restart it."""
+    trk = MultiTargetTracker(
+        factory, sigma_a=0.2, sigma_z=1.0, sigma_v0=5.0, confirm_m=2, confirm_n=3,
+        overlap_gate=0.5, delete_after=6,
+    )  # fmt: skip
+
+    def ship(k: int, h: float = 13.0, top: float = 230.0, w: float = 56.0, dx: float = 0.0):
+        return np.array([[564.0 + 0.3 * k + dx, top, w, h]])
+
+    for k in range(30):
+        st = trk.step(ship(k))
+    (sid,) = st.confirmed_tracks().ids
+    for k, box in (
+        (30, ship(30, h=38.0)),
+        (31, ship(31, h=38.0)),
+        (32, ship(32, h=6.0, top=231.0, w=20.0, dx=2.0)),
+        (33, ship(33, h=6.0, top=231.0, w=20.0, dx=2.0)),
+    ):
+        st = trk.step(box)
+        own = st.ids == sid
+        assert not st.restarted[own].any(), k
+        assert st.states[own, 0] == pytest.approx(564.0 + 0.3 * k + 28.0, abs=0.5)
+        assert st.states[own, 1] == pytest.approx(236.5, abs=0.5)
+        assert st.states[own, 3] == pytest.approx(0.0, abs=0.05)
+    st = trk.step(ship(34))
+    assert st.detection[st.ids == sid].tolist() == [0] and not st.restarted.any()
+    # the same growth upwards (bottom edge kept): a re-segmentation, restarted
+    trk.reset()
+    for k in range(30):
+        st = trk.step(ship(k))
+    st = trk.step(ship(30, h=38.0, top=205.0))
+    assert st.restarted.tolist() == [True]
+
+
 def test_overlap_stage_does_not_restart_a_boat_on_the_box_of_ships_merged_over_it():
     """A 16 × 5 px boat whose detection is, for two frames, one 114 × 32 px box of the
     ships passing in front of it (centre 47 px away, 45 × its area; rendered crossing

@@ -292,7 +292,10 @@ class MultiTargetTracker:
             (centre and size; velocity and id kept) instead of updated. It keeps the id
             of a ship whose box is re-segmented — a hull that gains its superstructure,
             a bow that becomes a whole ship at the image edge — where the centre jumps
-            out of the gate. None (default): off.
+            out of the gate; a confirmed track's water line (the box's bottom edge)
+            must stay within ``max(σ_z, 15 %)`` of its height (a piece of the ship
+            above the water, or the ship with glint or a wake below it, is no
+            re-segmentation). None (default): off.
         confirmed_first: a matching cascade (as in DeepSORT, Wojke et al. 2017): the
             confirmed tracks are assigned (gate, then overlap stage) before the
             tentative ones, which get only the detections left over — a track born on
@@ -709,7 +712,10 @@ class MultiTargetTracker:
         overlap by at least the gate (intersection over the smaller area), greedily by
         overlap (with ``confirmed_first``, the track with the most detections first),
         among the ``tracks`` marked True (default: all). Track boxes are the predicted
-        centres with the smoothed sizes."""
+        centres with the smoothed sizes. Not paired: a box over ten times the track's
+        area (:data:`_RESTART_GROWTH`), and for a confirmed track a box whose bottom
+        edge (the water line) is farther than ``max(σ_z, 15 %)`` of the track's height
+        from the predicted one."""
         empty = np.empty(0, np.int64)
         pool = np.arange(self.n_tracks) if tracks is None else np.flatnonzero(tracks)
         free_t = np.setdiff1d(pool, rows)
@@ -722,6 +728,13 @@ class MultiTargetTracker:
         # ships merged into one box (one passing in front of another): no restart
         area_t = np.prod(self._size[free_t], axis=1)
         ov[np.prod(ds, axis=1)[None] > _RESTART_GROWTH * area_t[:, None]] = 0.0
+        # a confirmed ship's water line (its box's bottom edge) stays where it was: a box
+        # whose bottom is elsewhere is a piece of it above the water (a superstructure,
+        # a mast) or holds something below it (glint, a wake), not its re-segmentation
+        bottom_t = self._X[free_t, 1] + 0.5 * self._size[free_t, 1]
+        tol = self._tolerance(self._size[free_t])[:, 1]
+        moved = np.abs(dc[None, :, 1] + 0.5 * ds[None, :, 1] - bottom_t[:, None]) > tol[:, None]
+        ov[moved & self._confirmed[free_t][:, None]] = 0.0
         if self.confirmed_first:  # pairs in the gate: most detections first, then overlap
             hits = np.where(ov >= self.overlap_gate, self._hits[free_t][:, None], -1)
             order = np.lexsort((-ov.ravel(), -hits.ravel()))
