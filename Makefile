@@ -63,6 +63,7 @@ results: $(VENV)/.installed-test
 		--out $(R)/stereo-ferry/stereo-prior
 	$(BIN)/seawatch demo --out out/demo --json > $(R)/demo/summary.json
 	$(BIN)/python $(R)/track/measure.py --out out/track-targets
+	$(BIN)/python $(R)/detect/measure.py --out out/detect-mardct
 	$(BIN)/seawatch bench video --repeats 3 --json > $(R)/bench/video.json
 	$(BIN)/seawatch bench world --json > $(R)/bench/world.json
 
