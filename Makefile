@@ -64,6 +64,7 @@ results: $(VENV)/.installed-test
 	$(BIN)/seawatch demo --out out/demo --json > $(R)/demo/summary.json
 	$(BIN)/python $(R)/track/measure.py --out out/track-targets
 	$(BIN)/python $(R)/detect/measure.py --out out/detect-mardct
+	$(BIN)/python $(R)/fvessel/measure.py
 	$(BIN)/seawatch bench video --repeats 3 --json > $(R)/bench/video.json
 	$(BIN)/seawatch bench world --json > $(R)/bench/world.json
 
