@@ -718,8 +718,12 @@ class MultiTargetTracker:
         from the predicted one."""
         empty = np.empty(0, np.int64)
         pool = np.arange(self.n_tracks) if tracks is None else np.flatnonzero(tracks)
-        free_t = np.setdiff1d(pool, rows)
-        free_d = np.setdiff1d(np.arange(z.shape[0]), cols)
+        taken = np.zeros(self.n_tracks, bool)
+        taken[rows] = True
+        free_t = pool[~taken[pool]]
+        used = np.zeros(z.shape[0], bool)
+        used[cols] = True
+        free_d = np.flatnonzero(~used)
         if free_t.size == 0 or free_d.size == 0:
             return empty, empty
         dc, ds = z[free_d], sizes[free_d]
