@@ -99,7 +99,15 @@ def test_cli_bad_case_exits_2_naming_the_option(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize(
-    ("opt", "value"), [("--width", "321"), ("--duration", "0"), ("--fps", "-5"), ("--crf", "52")]
+    ("opt", "value"),
+    [
+        ("--width", "321"),
+        ("--duration", "0"),
+        ("--fps", "-5"),
+        ("--crf", "52"),
+        ("--pan-deg", "50"),
+        ("--pan-period", "0"),
+    ],
 )
 def test_cli_bad_numbers_exit_2(tmp_path: Path, opt: str, value: str) -> None:
     args = ["synth", "ship-video", "--case", "small", "--out", str(tmp_path), opt, value]

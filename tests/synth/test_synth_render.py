@@ -100,6 +100,39 @@ def test_waterline_pixel_is_the_projection_of_the_ship_position_and_inverts_on_a
         assert math.isclose(float(row["range_m"]), rng, abs_tol=1e-3)
 
 
+def test_panning_camera_moves_the_ships_by_the_yaw_and_keeps_the_world_and_horizon() -> None:
+    """pan = (5°, 4 s): heading(t) = heading_0 + 5° sin(2 pi t / 4 s). At t = 1 s the
+    camera has turned 5° to the right: a ship at relative azimuth a and depression d
+    (level camera, no distortion) is seen at u = cx + fx tan(a − 5°), v = cy + fy tan(d) /
+    cos(a − 5°) instead of a; its world position, azimuth and depression, and the horizon
+    line, do not change."""
+    cam = _camera(pitch_deg=0.0)
+    n0, e0 = _ahead(cam, 900.0, 120.0)
+    ships = [make_ship(1, straight(n0, e0, 1.0, 4.0, 10.0), 60.0)]
+    fixed = Renderer(cam, ships, 10.0, seed=2)
+    panned = Renderer(cam, ships, 10.0, seed=2, pan=(math.radians(5.0), 4.0))
+    for k, turn in ((0, 0.0), (10, 5.0), (30, -5.0)):
+        f0, f1 = fixed.frame(k), panned.frame(k)
+        assert math.degrees(f1.camera.heading - cam.heading) == pytest.approx(turn, abs=1e-9)
+        (o0,), (o1,) = f0.objects, f1.objects
+        rel = math.atan2(o0.u_wl - cam.cx, cam.fx)  # level camera: u = cx + fx tan(a)
+        assert o1.u_wl - cam.cx == pytest.approx(
+            cam.fx * math.tan(rel - math.radians(turn)), abs=1e-6
+        )
+        # and v = cy + fy tan(depression) / cos(relative azimuth)
+        ratio = math.cos(rel) / math.cos(rel - math.radians(turn))
+        assert o1.v_wl - cam.cy == pytest.approx((o0.v_wl - cam.cy) * ratio, abs=1e-6)
+        for key in ("north", "east", "azimuth", "depression", "range"):
+            assert getattr(o1, key) == getattr(o0, key)
+        assert f1.horizon == pytest.approx(f0.horizon, abs=1e-9)
+    with pytest.raises(ValueError, match="pan"):
+        Renderer(cam, ships, 10.0, pan=(math.radians(50.0), 4.0))
+    with pytest.raises(ValueError, match="pan"):
+        Renderer(cam, ships, 10.0, pan=(0.1, 0.0))
+    with pytest.raises(ValueError, match="pan"):
+        Renderer(cam, ships, 10.0, pan=(0.1,))  # type: ignore[arg-type]
+
+
 def test_curved_earth_waterline_sits_at_the_curved_sea_depression() -> None:
     cam = _camera(hfov=10.0, pitch_deg=0.0, height=20.0)
     n0, e0 = _ahead(cam, 5000.0, 0.0)

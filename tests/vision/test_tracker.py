@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -72,6 +73,12 @@ def rendered(tmp_path_factory):
         res = render_case(name, tmp_path_factory.mktemp(name), duration=3.0, width=960, height=540)
         out[name] = (detect_video(res.video), read_truth(res.truth))
         out[f"{name}-video"] = res.video
+    # the large ship with the camera panning ±4° in 3 s (peak 8.4°/s, 4.8 px a frame)
+    res = render_case(
+        "large", tmp_path_factory.mktemp("pan"), duration=3.0, width=960, height=540,
+        pan=(math.radians(4.0), 3.0),
+    )  # fmt: skip
+    out["large-pan"] = (detect_video(res.video), read_truth(res.truth))
     return out
 
 
@@ -151,6 +158,22 @@ def test_rendered_large_ship_cle_below_2_percent_of_diagonal(rendered):
     assert np.unique(rows[:, 1]).size == 1
     assert r.coverage > 0.9
     assert r.mean_percent < 2.0  # issue 6 target (measured ~0.4 %)
+
+
+@pytest.mark.parametrize("name", ["afkf", "kf"])
+def test_rendered_large_ship_through_a_panning_camera_keeps_its_id(name, rendered):
+    """The camera pans ±4° about its heading in 3 s (the ship sweeps ±58 px across the
+    frame, up to 4.8 px a frame, with 0.4 px/frame² of acceleration): one track id, the
+    same coverage as the fixed camera, CLE under the 2 % target. Measured: 1.26 % (afkf),
+    0.90 % (kf) against 0.27 % with the camera fixed: the constant-velocity model lags
+    the pan's acceleration (no camera-motion compensation)."""
+    dets, truth = rendered["large-pan"]
+    vt = VisualTracker(detector=lambda *a, **k: None, horizon=False, filter=name)
+    rows = tracks_to_rows(vt.track_detections(dets))
+    r = centre_location_error(rows, truth)
+    assert np.unique(rows[:, 1]).size == 1
+    assert r.coverage > 0.95
+    assert r.mean_percent < 2.0
 
 
 def test_rendered_meeting_occlusion_handling_halves_the_centre_error(rendered):

@@ -58,6 +58,14 @@ def ship_video(
     crf: Annotated[
         int, typer.Option(help="libx264 quality: 0 (lossless) … 51; lower is better.")
     ] = 20,
+    pan_deg: Annotated[
+        float,
+        typer.Option(
+            help="Pan the camera to and fro about its heading by this amplitude [deg] "
+            "(0: fixed camera)."
+        ),
+    ] = 0.0,
+    pan_period: Annotated[float, typer.Option(help="Period of the pan [s].")] = 10.0,
     json_out: Annotated[
         bool, typer.Option("--json", help="Print a JSON summary on stdout.")
     ] = False,
@@ -72,6 +80,9 @@ def ship_video(
     frames are produced.
 
     Example: [cyan]seawatch synth ship-video --case meeting --out out/meeting --json[/]
+
+    Example: [cyan]seawatch synth ship-video --case large --pan-deg 4 --pan-period 6 --out
+    out/pan[/] (a camera panning ±4° about its heading)
     """
     from seawatch.synth.cases import CASES, render_case, ship_video_case
 
@@ -87,6 +98,10 @@ def ship_video(
                 raise BadInput(f"{name}: expected an even number of pixels >= 16, got {value}")
         if not 0 <= crf <= 51:
             raise BadInput(f"--crf: expected an integer in 0 … 51 (libx264), got {crf}")
+        if not 0.0 <= pan_deg <= 45.0:
+            raise BadInput(f"--pan-deg: expected an amplitude in 0 … 45 degrees, got {pan_deg}")
+        if not pan_period > 0.0:
+            raise BadInput(f"--pan-period: expected a positive number of seconds, got {pan_period}")
         info = ship_video_case(case, duration=duration, width=width, height=height, seed=seed)
         with progress_bar() as bar:
             task = bar.add_task(f"synth {case}", total=max(1, round(duration * fps)))
@@ -100,6 +115,7 @@ def ship_video(
                 seed=seed,
                 progress=lambda done, total: bar.update(task, completed=done, total=total),
                 crf=crf,
+                pan=(math.radians(pan_deg), pan_period) if pan_deg > 0.0 else None,
             )
         doc = {
             "case": case,
@@ -107,6 +123,8 @@ def ship_video(
             "lighting": info.lighting.name,
             "seed": seed,
             "crf": crf,
+            "pan_deg": pan_deg,
+            "pan_period_s": pan_period,
             **result.to_json(),
         }
         if json_out:

@@ -281,10 +281,12 @@ def render_case(
     seed: int = 0,
     progress: Callable[[int, int], None] | None = None,
     crf: int = 20,
+    pan: tuple[float, float] | None = None,
 ) -> RenderResult:
     """Render the case ``name`` into ``out_dir`` (video.mp4, camera.yaml, truth.csv,
     horizon.csv) with :func:`seawatch.synth.render` (``crf``: libx264's quality, 0
-    lossless)."""
+    lossless; ``pan``: (amplitude [rad], period [s]) of a camera panning to and fro, as
+    :class:`~seawatch.synth.render.Renderer`; None: the case's fixed heading)."""
     case = ship_video_case(name, duration=duration, width=width, height=height, seed=seed)
     return render(
         case.camera,
@@ -298,5 +300,6 @@ def render_case(
         seed=case.seed,
         progress=progress,
         crf=crf,
+        pan=pan,
         description=f"seawatch synth ship-video --case {name}: {case.description}",
     )

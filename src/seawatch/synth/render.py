@@ -380,7 +380,7 @@ class RenderedFrame:
     Attributes:
         index: frame number (0-based).
         time: video time [s] (index / fps).
-        camera: the camera of this frame (mounting attitude plus sway).
+        camera: the camera of this frame (mounting attitude plus sway and pan).
         yuv: (3 H / 2, W) uint8 I420 image (BT.601 limited range), as encoded.
         objects: visible objects, far to near.
         horizon: (x0, y0, x1, y1) [px], the horizon line at the image borders.
@@ -485,6 +485,10 @@ class Renderer:
         fps: frame rate [1/s].
         lighting: a preset name of :data:`LIGHTINGS` or a :class:`Lighting`.
         sway: (roll_amp [rad], pitch_amp [rad], period [s]) or None (:func:`sway_attitude`).
+        pan: (amplitude [rad], period [s]) of a camera panning to and fro about its
+            mounting heading, ``heading(t) = heading_0 + amplitude sin(2 pi t / period)``
+            (a scanning PTZ camera, a yawing boat), or None. The world stays put: the
+            ships, the sun glint and the coastline move across the frame.
         coastline: draw a coastline band standing on the horizon.
         seed: seeds the waves, clouds, coastline, sway phases and sensor noise; the same
             seed gives the same pixels.
@@ -506,6 +510,7 @@ class Renderer:
         earth: Earth = "flat",
         start_time: float = 0.0,
         noise: bool = True,
+        pan: tuple[float, float] | None = None,
     ) -> None:
         if not isinstance(camera, PinholeCamera):
             raise ValueError(f"camera: expected a PinholeCamera, got {type(camera).__name__}")
@@ -545,6 +550,12 @@ class Renderer:
             period = positive("sway period", sway[2])
             sway = None if ra == 0.0 and pa == 0.0 else (ra, pa, period)
         self.sway = sway
+        if pan is not None:
+            if len(pan) != 2:
+                raise ValueError("pan: expected (amplitude [rad], period [s])")
+            amp = in_range("pan amplitude", pan[0], 0.0, math.pi / 4)
+            pan = None if amp == 0.0 else (amp, positive("pan period", pan[1]))
+        self.pan = pan
         if earth not in ("flat", "curved"):
             raise ValueError(f"earth: expected 'flat' or 'curved', got {earth!r}")
         self.earth: Earth = earth
@@ -569,11 +580,15 @@ class Renderer:
 
     # ------------------------------------------------------------ attitude
     def camera_at(self, index: int) -> PinholeCamera:
-        """The camera of frame ``index``: mounting attitude plus sway."""
-        if self.sway is None:
+        """The camera of frame ``index``: mounting attitude plus sway and pan."""
+        if self.sway is None and self.pan is None:
             return self.camera
-        pitch, roll = sway_attitude(self.camera, index / self.fps, self.sway, self._phases)
-        return self.camera.with_attitude(pitch=pitch, roll=roll)
+        t = index / self.fps
+        pitch, roll = sway_attitude(self.camera, t, self.sway, self._phases)
+        heading = self.camera.heading
+        if self.pan is not None:
+            heading += self.pan[0] * math.sin(2.0 * math.pi * t / self.pan[1])
+        return self.camera.with_attitude(heading=heading, pitch=pitch, roll=roll)
 
     # ------------------------------------------------------------ background
     def _canvas_camera(self) -> tuple[PinholeCamera, bool]:
@@ -590,18 +605,20 @@ class Renderer:
             roll=0.0,
             height=cam.height,
         )
-        if self.sway is None and cam.roll == 0.0:
+        if self.sway is None and self.pan is None and cam.roll == 0.0:
             return level, False
-        attitudes = [(cam.pitch, cam.roll)]
+        attitudes = [(cam.heading, cam.pitch, cam.roll)]
         ra, pa = (self.sway[0], self.sway[1]) if self.sway is not None else (0.0, 0.0)
-        for dr in (-ra, ra):
-            for dp in (-pa, pa):
-                attitudes.append((cam.pitch + dp, cam.roll + dr))
+        ya = self.pan[0] if self.pan is not None else 0.0
+        for dy in (-ya, 0.0, ya):
+            for dr in (-ra, ra):
+                for dp in (-pa, pa):
+                    attitudes.append((cam.heading + dy, cam.pitch + dp, cam.roll + dr))
         corners = np.array([[-0.5, -0.5, 1.0], [w - 0.5, -0.5, 1.0], [-0.5, h - 0.5, 1.0]])
         corners = np.vstack([corners, [w - 0.5, h - 0.5, 1.0]])
         pts = []
-        for pitch, roll in attitudes:
-            H = self._homography(level, cam.with_attitude(pitch=pitch, roll=roll))
+        for heading, pitch, roll in attitudes:
+            H = self._homography(level, cam.with_attitude(heading=heading, pitch=pitch, roll=roll))
             p = corners @ H.T
             pts.append(p[:, :2] / p[:, 2:3])
         allp = np.vstack(pts)
@@ -1408,6 +1425,7 @@ def render(
     crf: int = 20,
     preset: str = "ultrafast",
     description: str | None = None,
+    pan: tuple[float, float] | None = None,
 ) -> RenderResult:
     """Render ``duration`` [s] of footage at ``fps`` [1/s] into ``out_dir``.
 
@@ -1437,6 +1455,7 @@ def render(
         earth=earth,
         start_time=start_time,
         noise=noise,
+        pan=pan,
     )
     out = Path(out_dir)
     try:
