@@ -416,6 +416,7 @@ class MultiTargetTracker:
         self._filters: list[TrackFilter] = []
         self._next_id = 1
         self._time: float | None = None
+        self._anchored: tuple[NDArray[np.int64], FloatArray, NDArray[np.bool_]] | None = None
         self._boxes: bool | None = None
 
     @property
@@ -493,6 +494,7 @@ class MultiTargetTracker:
         boxes = sizes is not None and self.overlap_gate is not None
         zs = None if sizes is None else sizes[valid]
         edges = None  # tracks measured by the free edges of their boxes
+        self._anchored = None  # the gate's anchored centres of this scan (_anchor_pairs)
         if zs is not None and self.occlusion and np.count_nonzero(self._confirmed) >= 2:
             edges = self._confirmed.copy()
         if self.confirmed_first:
@@ -684,7 +686,8 @@ class MultiTargetTracker:
             ct = np.flatnonzero(edges)
             rest = ~edges[rows]
             cr, cc = np.repeat(ct, D), np.tile(np.arange(D), ct.size)
-            za, _ = self._anchor(cr, z[cc], sizes[cc])
+            za, free = self._anchor(cr, z[cc], sizes[cc])
+            self._anchored = (ct, za.reshape(ct.size, D, _DIM), free.reshape(ct.size, D, _DIM))
             told = np.all(np.isfinite(za), axis=1)
             cr, cc, za = cr[told], cc[told], za[told]
             rows = np.concatenate([rows[rest], cr])
@@ -857,6 +860,25 @@ class MultiTargetTracker:
         )
         return centre, ~blocked_lo & ~blocked_hi
 
+    def _anchor_pairs(
+        self, rows: NDArray[np.int64], cols: NDArray[np.int64], z: FloatArray, sizes: FloatArray
+    ) -> tuple[FloatArray, NDArray[np.bool_]]:
+        """:meth:`_anchor` of the pairs (track ``rows``, detection ``cols``) for confirmed
+        tracks — from the gate's computation of this scan where it made it (the same
+        inputs, the same result) — and the box centre with both axes free for the
+        others."""
+        zu, free = z[cols].copy(), np.ones((rows.size, _DIM), bool)
+        mine = self._confirmed[rows]
+        if self._anchored is not None and rows.size:
+            ct, za, fr = self._anchored
+            pos = np.minimum(np.searchsorted(ct, rows), ct.size - 1)
+            hit = mine & (ct[pos] == rows)
+            zu[hit], free[hit] = za[pos[hit], cols[hit]], fr[pos[hit], cols[hit]]
+            mine &= ~hit
+        if mine.any():
+            zu[mine], free[mine] = self._anchor(rows[mine], z[cols[mine]], sizes[cols[mine]])
+        return zu, free
+
     def _occlusion(
         self,
         rows: NDArray[np.int64],
@@ -905,15 +927,13 @@ class MultiTargetTracker:
             ok = ov[np.arange(t.size), best] >= (self.overlap_gate or 0.5)
             t, best = t[ok], best[ok]
             if t.size:
-                za, _ = self._anchor(t, z[best], sizes[best])
+                za, _ = self._anchor_pairs(t, best, z, sizes)
                 y = za - self._X[t] @ self.H.T
                 d2, _ = _mahalanobis2(self._innovation_covariance()[t], y)
                 inside = d2 <= self.gate  # False for NaN: the box does not tell
                 rows = np.concatenate([rows, t[inside]])
                 cols = np.concatenate([cols, best[inside]])
-        zu, free = self._anchor(rows, z[cols], sizes[cols])
-        mine = self._confirmed[rows][:, None]
-        zu, free = np.where(mine, zu, z[cols]), np.where(mine, free, True)
+        zu, free = self._anchor_pairs(rows, cols, z, sizes)
         told = np.all(np.isfinite(zu), axis=1)  # a box that does not tell: a miss
         return rows[told], cols[told], r2, c2, zu[told], free[told], np.flatnonzero(merged)
 
