@@ -431,6 +431,8 @@ def test_non_increasing_times_raise_naming_time():
         ({"confirm_m": 4, "confirm_n": 3}, "confirm_m"),
         ({"confirm_n": 0}, "confirm_n"),
         ({"delete_after": 0}, "delete_after"),
+        ({"coast_ratio": 0.0}, "coast_ratio"),
+        ({"coast_ratio": float("nan")}, "coast_ratio"),
         ({"gate_probability": 1.0}, "gate_probability"),
         ({"gate_threshold": -1.0}, "gate_threshold"),
         ({"sigma_z": 0.0}, "sigma_z"),
@@ -450,6 +452,22 @@ def test_non_increasing_times_raise_naming_time():
 def test_bad_parameters_raise_naming_the_parameter(kwargs, name):
     with pytest.raises(ValueError, match=name):
         MultiTargetTracker(**kwargs)
+
+
+@pytest.mark.parametrize("ratio", [None, 1.0, 2.0])
+def test_coast_ratio_bounds_coasting_by_the_detections_a_track_has_had(ratio):
+    """A point seen for ``n`` scans, then never again: with ``coast_ratio`` r it lives
+    while its consecutive misses stay under min(delete_after, r n) (delete_after = 12):
+    n = 3 → 3 or 6 misses with r = 1 or 2, n = 20 → 12; without it, 12 either way."""
+    for seen in (3, 20):
+        trk = _tracker(confirm_m=3, confirm_n=3, delete_after=12, coast_ratio=ratio)
+        for k in range(seen):
+            trk.step(np.array([[10.0 + k, 5.0]]))
+        alive = 0
+        while len(trk.step(None)):
+            alive += 1
+        limit = 12 if ratio is None else min(12, int(ratio * seen))
+        assert alive == limit - 1, (seen, ratio, alive)  # deleted on the limit-th miss
 
 
 def test_confirmed_first_keeps_a_detection_for_the_confirmed_track():

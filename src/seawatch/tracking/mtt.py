@@ -37,8 +37,9 @@ image (pixels) or as points on the sea (metres). One scan:
    (``x0 = [z, 0, 0]``, ``P0 = diag(σ_z², σ_z², σ_v0², σ_v0²)``); a tentative track is
    *confirmed* once it has M detections among its last N scans (M-of-N, counting its
    birth) and is deleted as soon as it can no longer reach M within its first N scans;
-   a confirmed track is deleted after K consecutive misses. Track ids are integers that
-   are never reused.
+   a confirmed track is deleted after K consecutive misses (with ``coast_ratio`` r, also
+   once they reach r times its detections). Track ids are integers that are never
+   reused.
 
 Boxes ``(x, y, w, h)`` (top-left corner, width, height) are tracked by their centre;
 the size is smoothed alongside by exponential smoothing of (w, h).
@@ -283,6 +284,12 @@ class MultiTargetTracker:
         gate_threshold: the gate ``gamma`` on d² directly (overrides the probability).
         confirm_m, confirm_n: M-of-N confirmation (1 <= M <= N).
         delete_after: K, consecutive misses that delete a confirmed track (>= 1).
+        coast_ratio: with a value r > 0, a confirmed track is also deleted once its
+            consecutive misses reach r times the detections it has had (at least one):
+            a track confirmed on three detections of glint or a wake coasts for a few
+            frames, a ship seen for a hundred frames for the whole ``delete_after`` (the
+            evidence a track has gathered bounds how long it lives on prediction alone,
+            as a track score would). None (default): ``delete_after`` for every track.
         size_smoothing: weight of a new box size in the exponential smoothing of
             (w, h), in (0, 1] (1: no smoothing).
         overlap_gate: boxes only — a second association stage for what the gate left
@@ -332,6 +339,7 @@ class MultiTargetTracker:
         confirmed_first: bool = False,
         occlusion: bool = False,
         filter_options: dict[str, Any] | None = None,
+        coast_ratio: float | None = None,
     ) -> None:
         self.dt = positive("dt", dt)
         self.sigma_a = positive("sigma_a", sigma_a, allow_zero=True)
@@ -349,6 +357,7 @@ class MultiTargetTracker:
         if self.confirm_n > 62:
             raise ValueError(f"confirm_n: expected <= 62, got {confirm_n}")
         self.delete_after = _count("delete_after", delete_after, 1)
+        self.coast_ratio = None if coast_ratio is None else positive("coast_ratio", coast_ratio)
         self.size_smoothing = in_range("size_smoothing", size_smoothing, 0.0, 1.0, lo_open=True)
         self.overlap_gate = (
             None
@@ -539,7 +548,10 @@ class MultiTargetTracker:
         newly = ~self._confirmed & (window_hits >= self.confirm_m)
         self._confirmed |= newly
         can_confirm = window_hits + np.maximum(self.confirm_n - self._age, 0) >= self.confirm_m
-        keep = np.where(self._confirmed, self._misses < self.delete_after, can_confirm)
+        limit = np.full(self.n_tracks, float(self.delete_after))
+        if self.coast_ratio is not None:
+            limit = np.minimum(limit, np.maximum(self.coast_ratio * self._hits, 1.0))
+        keep = np.where(self._confirmed, self._misses < limit, can_confirm)
         self._compress(keep)
         detection = detection[keep]
         restarted = restarted[keep]

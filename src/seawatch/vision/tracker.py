@@ -103,6 +103,10 @@ class VisualTracker:
         confirm_m, confirm_n: M-of-N confirmation.
         delete_after: consecutive missed frames after which a confirmed track is
             dropped (the occlusion it survives by prediction).
+        coast_ratio: a confirmed track is also dropped once its missed frames reach
+            this times its detections (a track confirmed on a few frames of glint or
+            wake coasts a few frames, a ship seen for long the whole ``delete_after``);
+            None: ``delete_after`` for every track.
         size_smoothing: weight of a new box size in the exponential smoothing, (0, 1].
         overlap_gate: second association stage of the tracker (:class:`~seawatch.
             tracking.mtt.MultiTargetTracker`): an unpaired track and detection whose boxes
@@ -139,6 +143,7 @@ class VisualTracker:
         confirm_m: int = 3,
         confirm_n: int = 5,
         delete_after: int = 12,
+        coast_ratio: float | None = 2.0,
         size_smoothing: float = 0.3,
         overlap_gate: float | None = 0.5,
         confirmed_first: bool = True,
@@ -178,6 +183,7 @@ class VisualTracker:
             confirm_m=confirm_m,
             confirm_n=confirm_n,
             delete_after=delete_after,
+            coast_ratio=coast_ratio,
             size_smoothing=size_smoothing,
             overlap_gate=overlap_gate,
             confirmed_first=confirmed_first,
