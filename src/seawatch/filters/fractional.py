@@ -541,24 +541,17 @@ class FractionalKalmanFilter:
             z: measurement (m,) or (B..., m), absolute coordinates (px for the image
                 model); NaN in a row or ``None``: predict-only for that track. Before any
                 state exists (``x0=None``) the first z initialises the filter.
-            R: measurement covariance (m, m) for this update only (default ``self.R``),
-                e.g. a very large variance on a coordinate the measurement does not
-                tell (the update then leaves it to the prediction).
+            R: measurement covariance for this update only (default ``self.R``), as the
+                constructor's R: (m, m), a diagonal (m,) or a scalar, positive definite
+                (e.g. a very large variance on a coordinate the measurement does not
+                tell: the update then leaves it to the prediction).
 
         Raises:
             numpy.linalg.LinAlgError: singular innovation covariance.
-            ValueError: ``R`` of the wrong shape, not finite or not symmetric.
+            ValueError: ``R`` not a finite positive-definite (m, m) covariance.
         """
         m = self.dim_z
-        if R is None:
-            Rk = self.R
-        else:
-            Rk = np.asarray(R, dtype=np.float64)
-            if Rk.shape != (m, m) or not np.all(np.isfinite(Rk)) or not np.allclose(Rk, Rk.T):
-                raise ValueError(
-                    f"R: expected a finite symmetric ({m}, {m}) matrix, got shape {Rk.shape}"
-                )
-            Rk = np.ascontiguousarray(Rk)
+        Rk = self.R if R is None else covariance("R", R, m, positive_definite=True)
         if z is None:
             self._need_state("update(None)")
             za = np.full(m, np.nan)
