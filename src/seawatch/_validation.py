@@ -154,6 +154,15 @@ def in_range(
     return v
 
 
+def integer(name: str, value: object, minimum: int, maximum: int | None = None) -> int:
+    """An integer (Python or numpy; not a bool) >= *minimum* and, if given, <= *maximum*."""
+    ok = not isinstance(value, bool) and isinstance(value, int | np.integer)
+    if not ok or value < minimum or (maximum is not None and value > maximum):  # type: ignore[operator]
+        want = f">= {minimum}" if maximum is None else f"in {minimum} … {maximum}"
+        raise ValueError(f"{name}: expected an integer {want}, got {value!r}")
+    return int(value)  # type: ignore[call-overload]
+
+
 def int_pair(name: str, value: object, labels: tuple[str, str], minimum: int) -> tuple[int, int]:
     """Two integers (e.g. a size in pixels) given as a pair, both >= *minimum*; *labels*
     name the two in the error message (``("width", "height")``)."""

@@ -47,6 +47,7 @@ from seawatch._validation import (
     covariance,
     finite,
     in_range,
+    integer,
     linear_model,
     positive,
 )
@@ -88,12 +89,6 @@ def _orders(value: ArrayLike, n: int | None) -> FloatArray:
     return arr
 
 
-def _count(name: str, value: int, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
-        raise ValueError(f"{name}: expected an integer >= {minimum}, got {value!r}")
-    return int(value)
-
-
 def gl_coefficients(order: ArrayLike, count: int) -> FloatArray:
     """Signed Grünwald–Letnikov coefficients ``c_j = (-1)^j binom(alpha, j)``, j = 0..count-1.
 
@@ -111,7 +106,7 @@ def gl_coefficients(order: ArrayLike, count: int) -> FloatArray:
         are the diagonals of ``Y_j`` (``Y_0 = I``).
     """
     alpha = _orders(order, None)
-    count = _count("count", count, 1)
+    count = integer("count", count, 1)
     c = np.empty((count, *alpha.shape))
     c[0] = 1.0
     for j in range(1, count):
@@ -373,7 +368,7 @@ class FractionalKalmanFilter:
         self.P0: FloatArray = covariance("P0", P0, n, batch=True)
         alpha = _orders(order, n)
         self.order: FloatArray = np.broadcast_to(alpha, (n,)).copy()
-        self.memory = _count("memory", memory, 1)
+        self.memory = integer("memory", memory, 1)
         self.relative = bool(relative)
         self.dim_x, self.dim_z = n, m
         # c[j, i] = c_j(alpha_i), j = 0..L; Y_1 = diag(c[1])
@@ -776,7 +771,7 @@ class AdaptiveFractionalKalmanFilter(FractionalKalmanFilter):
             raise ValueError(f"rule: expected 'R1' or 'R2', got {rule!r}")
         self.rule = rule
         self.gain = positive("gain", (1.0 if rule == "R1" else 4.0) if gain is None else gain)
-        self.window = _count("window", window, 1)
+        self.window = integer("window", window, 1)
         self.g_max = in_range("g_max", g_max, 1.0, np.inf)
         self.delta = positive("delta", delta)
         super().__init__(A, H, Q0, R, x0, P0, order=order, memory=memory, relative=relative)

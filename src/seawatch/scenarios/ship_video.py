@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from seawatch._validation import integer
 from seawatch.io.video import VideoReader
 from seawatch.metrics.cle import CLEResult, centre_location_error
 from seawatch.scenarios.base import ExperimentResult, ProgressCallback, record
@@ -131,8 +132,6 @@ def _unit_options(
     crf: int,
 ) -> dict[str, Any]:
     """The rendering and sweep options of :func:`_unit`, checked."""
-    if isinstance(crf, bool) or not isinstance(crf, int) or not 0 <= crf <= 51:
-        raise ValueError(f"crf: expected an integer in 0 … 51 (libx264), got {crf!r}")
     return {
         "width": width,
         "height": height,
@@ -140,7 +139,7 @@ def _unit_options(
         "orders": _orders(orders),
         "small_scale": small_scale,
         "fps": fps,
-        "crf": crf,
+        "crf": integer("crf", crf, 0, 51),  # libx264's range
     }
 
 

@@ -77,7 +77,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from seawatch._validation import FloatArray, in_range, positive
+from seawatch._validation import FloatArray, in_range, integer, positive
 from seawatch.camera import PinholeCamera, horizon_line
 from seawatch.geometry import horizon_dip, horizon_distance, north_east_to_geodetic
 from seawatch.geometry.sea import effective_radius
@@ -1441,8 +1441,7 @@ def render(
 
     d = positive("duration", duration)
     f = positive("fps", fps)
-    if isinstance(crf, bool) or not isinstance(crf, int | np.integer) or not 0 <= crf <= 51:
-        raise ValueError(f"crf: expected an integer in 0 … 51 (libx264), got {crf!r}")
+    crf = integer("crf", crf, 0, 51)
     n_frames = max(1, round(d * f))
     renderer = Renderer(
         camera,

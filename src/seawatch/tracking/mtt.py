@@ -63,7 +63,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 from scipy.stats import chi2
 
-from seawatch._validation import FloatArray, as_float_array, in_range, positive
+from seawatch._validation import FloatArray, as_float_array, in_range, integer, positive
 from seawatch.filters.fractional import FractionalKalmanFilter
 from seawatch.filters.kalman import KalmanFilter
 from seawatch.models.kinematic import constant_velocity, position_measurement
@@ -248,12 +248,6 @@ def _mahalanobis2(S: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray]
     return (d * y[:, 0] ** 2 - 2.0 * b * y[:, 0] * y[:, 1] + a * y[:, 1] ** 2) / det, det
 
 
-def _count(name: str, value: int, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
-        raise ValueError(f"{name}: expected an integer >= {minimum}, got {value!r}")
-    return int(value)
-
-
 class MultiTargetTracker:
     """GNN multi-target tracker with M-of-N confirmation (module docstring, steps 1–5).
 
@@ -350,13 +344,13 @@ class MultiTargetTracker:
             self.gate = float(chi2.ppf(p, _DIM))
         else:
             self.gate = positive("gate_threshold", gate_threshold)
-        self.confirm_n = _count("confirm_n", confirm_n, 1)
-        self.confirm_m = _count("confirm_m", confirm_m, 1)
+        self.confirm_n = integer("confirm_n", confirm_n, 1)
+        self.confirm_m = integer("confirm_m", confirm_m, 1)
         if self.confirm_m > self.confirm_n:
             raise ValueError(f"confirm_m: expected <= confirm_n = {confirm_n}, got {confirm_m}")
         if self.confirm_n > 62:
             raise ValueError(f"confirm_n: expected <= 62, got {confirm_n}")
-        self.delete_after = _count("delete_after", delete_after, 1)
+        self.delete_after = integer("delete_after", delete_after, 1)
         self.coast_ratio = None if coast_ratio is None else positive("coast_ratio", coast_ratio)
         self.size_smoothing = in_range("size_smoothing", size_smoothing, 0.0, 1.0, lo_open=True)
         self.overlap_gate = (

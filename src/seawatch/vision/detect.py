@@ -40,7 +40,7 @@ from numba import njit
 from numpy.typing import ArrayLike, NDArray
 from scipy.special import ndtri as _ndtri
 
-from seawatch._validation import FloatArray, in_range, int_pair, positive
+from seawatch._validation import FloatArray, in_range, int_pair, integer, positive
 from seawatch.vision.planes import _image_planes
 from seawatch.vision.waterline import _frame_ships, _waterline, waterline_points
 
@@ -569,12 +569,6 @@ def _cell_noise(
     return _upsample(q, d.shape, ch, cw, floor)
 
 
-def _int(name: str, value: Any, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
-        raise ValueError(f"{name}: expected an integer >= {minimum}, got {value!r}")
-    return int(value)
-
-
 def _in_sea(
     u: float,
     v: float,
@@ -855,10 +849,10 @@ class ClassicalShipDetector:
         if polarity not in ("both", "bright", "dark"):
             raise ValueError(f"polarity: expected 'both', 'bright' or 'dark', got {polarity!r}")
         self.polarity: Polarity = polarity
-        self.work_height = _int("work_height", work_height, 16)
-        self.levels = _int("levels", levels, 1)
-        self.guard = _int("guard", guard, 1)
-        self.flank = _int("flank", flank, 2)
+        self.work_height = integer("work_height", work_height, 16)
+        self.levels = integer("levels", levels, 1)
+        self.guard = integer("guard", guard, 1)
+        self.flank = integer("flank", flank, 2)
         self.cell = int_pair("cell", cell, ("rows", "cols"), 2)
         self.min_size = positive("min_size", min_size)
         self.min_area = positive("min_area", min_area, allow_zero=True)
@@ -872,7 +866,7 @@ class ClassicalShipDetector:
         if not (wide >= 1 and tall >= 1 and math.isfinite(wide) and math.isfinite(tall)):
             raise ValueError(f"max_aspect: expected finite limits >= 1, got {max_aspect!r}")
         self.max_aspect = (wide, tall)
-        self.border = _int("border", border, 0)
+        self.border = integer("border", border, 0)
         self.merge_gap = positive("merge_gap", merge_gap, allow_zero=True)
         self.max_above = in_range("max_above", max_above, 0.0, 1.0)
         self.horizon_tolerance = in_range("horizon_tolerance", horizon_tolerance, 0.0, 1.0)
@@ -880,7 +874,7 @@ class ClassicalShipDetector:
         self._rate = in_range("temporal_rate", temporal_rate, 0.0, 1.0, lo_open=True)
         self._tms: dict[int, _TemporalModel] = {}
         self.clutter_rate = positive("clutter_rate", clutter_rate, allow_zero=True)
-        self.max_candidates = _int("max_candidates", max_candidates, 1)
+        self.max_candidates = integer("max_candidates", max_candidates, 1)
         self.colour = bool(colour)
         if refine not in ("mask", "flank"):
             raise ValueError(f"refine: expected 'mask' or 'flank', got {refine!r}")

@@ -34,7 +34,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from seawatch._validation import FloatArray, as_float_array, in_range, positive
+from seawatch._validation import FloatArray, as_float_array, in_range, integer, positive
 from seawatch.filters import (
     AdaptiveFractionalKalmanFilter,
     FractionalKalmanFilter,
@@ -160,9 +160,7 @@ class VisualTracker:
         self.detector = ClassicalShipDetector() if detector is None else detector
         self.filter = filter
         self.order = positive("order", order)
-        if isinstance(memory, bool) or not isinstance(memory, int | np.integer) or memory < 1:
-            raise ValueError(f"memory: expected an integer >= 1, got {memory!r}")
-        self.memory = int(memory)
+        self.memory = integer("memory", memory, 1)
         self.min_score = in_range("min_score", min_score, 0.0, 1.0)
         self.fps = positive("fps", fps)
         self.use_horizon = bool(horizon)
