@@ -66,6 +66,7 @@ results: $(VENV)/.installed-test
 	$(BIN)/python $(R)/detect/measure.py --out out/detect-mardct
 	$(BIN)/python $(R)/fvessel/measure.py
 	$(BIN)/seawatch bench video --repeats 3 --json > $(R)/bench/video.json
+	$(BIN)/seawatch bench mtt --json > $(R)/bench/mtt.json
 	$(BIN)/seawatch bench world --json > $(R)/bench/world.json
 
 clean:
