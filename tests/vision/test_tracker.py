@@ -13,6 +13,7 @@ from seawatch.metrics import mot_metrics
 from seawatch.metrics.cle import centre_location_error
 from seawatch.scenarios.ship_video import detect_video, read_truth
 from seawatch.synth import render_case
+from seawatch.vision.detect import Detections
 from seawatch.vision.tracker import TRACK_COLUMNS, VisualTracker, tracks_to_rows
 
 
@@ -225,11 +226,9 @@ def test_fvessel_real_detections_keep_every_ship_with_few_ids():
     on real data, and every ship must be covered by a track for most of its frames."""
     gt = read_mot(FVESSEL / "Video-01_gt_tracking.txt")
     det = read_mot(FVESSEL / "Video-01_re_detection.txt")
-    scans = []
-    for f in range(int(gt[:, 0].max()) + 1):
-        b = det[det[:, 0] == f, 2:6]
-        wl = np.column_stack([b[:, 0] + b[:, 2] / 2, b[:, 1] + b[:, 3]])
-        scans.append(np.column_stack([b, np.ones(len(b)), wl]))
+    scans = [
+        Detections.from_boxes(det[det[:, 0] == f, 2:6]) for f in range(int(gt[:, 0].max()) + 1)
+    ]
     vt = VisualTracker(detector=lambda *a, **k: None, horizon=False, fps=1.0)
     rows = tracks_to_rows(vt.track_detections(scans))
     m = mot_metrics(gt, rows, "iou", 0.5)

@@ -26,6 +26,7 @@ import numpy as np
 
 from seawatch.io.mot import read_mot
 from seawatch.metrics import mot_metrics
+from seawatch.vision.detect import Detections
 from seawatch.vision.tracker import FILTERS, VisualTracker, tracks_to_rows
 
 SIGMA_Z_SWEEP = (4.0, 8.0)
@@ -50,14 +51,9 @@ def _scores(gt: np.ndarray, rows: np.ndarray) -> dict[str, float | int]:
     }
 
 
-def _per_frame(det: np.ndarray, frames: int) -> list[np.ndarray]:
-    """Per-frame (k, 7) detections x, y, w, h, score, u_wl, v_wl (bottom centre)."""
-    out = []
-    for f in range(frames):
-        b = det[det[:, 0] == f, 2:6]
-        wl = np.column_stack([b[:, 0] + b[:, 2] / 2, b[:, 1] + b[:, 3]])
-        out.append(np.column_stack([b, np.ones(len(b)), wl]))
-    return out
+def _per_frame(det: np.ndarray, frames: int) -> list[Detections]:
+    """Per-frame detections of MOT rows (score 1, water line at the box's bottom centre)."""
+    return [Detections.from_boxes(det[det[:, 0] == f, 2:6]) for f in range(frames)]
 
 
 def main() -> int:
