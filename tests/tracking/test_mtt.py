@@ -323,10 +323,9 @@ def test_overlap_stage_keeps_a_confirmed_ships_water_line(factory):
     and velocity stay within 0.5 px and 0.05 px/frame, and it takes its own box again.
     The same scans with the ship's bottom edge kept (a superstructure gained, as in the
     re-segmentation test above) do restart it."""
-    trk = MultiTargetTracker(
-        factory, sigma_a=0.2, sigma_z=1.0, sigma_v0=5.0, confirm_m=2, confirm_n=3,
-        overlap_gate=0.5, delete_after=6,
-    )  # fmt: skip
+    trk = _tracker(
+        filter_factory=factory, confirm_m=2, confirm_n=3, overlap_gate=0.5, delete_after=6
+    )
 
     def ship(k: int, h: float = 13.0, top: float = 230.0, w: float = 56.0, dx: float = 0.0):
         return np.array([[564.0 + 0.3 * k + dx, top, w, h]])
