@@ -147,6 +147,26 @@ def test_single_target_track_equals_kalman_filter_over_its_measurements():
     np.testing.assert_allclose(out.covariances[0], ref.covariances[-1], atol=1e-9)
 
 
+@pytest.mark.parametrize("factory", [None, KalmanFilter])
+def test_size_relative_noise_is_a_kalman_filter_with_that_r(factory):
+    """A 300 × 60 px box (constant size) with sigma_z_rel = 0.03 and σ_z = 1 px: the
+    track is the Kalman filter over the box centres with R = diag(9², 1.8²) =
+    diag(max(σ_z, 0.03 · 300)², max(σ_z, 0.03 · 60)²), on the batched path and with
+    per-track filter objects alike; a 20 × 10 px box keeps R = σ_z² I."""
+    rng = np.random.default_rng(7)
+    for size, sig in (((300.0, 60.0), (9.0, 1.8)), ((20.0, 10.0), (1.0, 1.0))):
+        zs = np.column_stack([400 + 1.5 * np.arange(25), 300 - 0.5 * np.arange(25)])
+        zs = zs + 0.5 * np.array(sig) * rng.standard_normal(zs.shape)  # all in the gate
+        trk = _tracker(filter_factory=factory, sigma_z_rel=0.03)
+        for z in zs:
+            out = trk.step(np.array([[z[0] - size[0] / 2, z[1] - size[1] / 2, *size]]))
+        R = np.diag(np.square(sig))
+        kf = KalmanFilter(trk.F, trk.H, trk.Q, R, np.r_[zs[0], 0.0, 0.0], trk.P0)
+        ref = kf.filter(zs[1:])
+        np.testing.assert_allclose(out.states[0], ref.states[-1], atol=1e-9)
+        np.testing.assert_allclose(out.covariances[0], ref.covariances[-1], atol=1e-9)
+
+
 def test_irregular_scan_times_use_the_actual_interval():
     times = np.cumsum(np.r_[0.0, np.random.default_rng(1234).uniform(0.5, 2.0, 40)])
     truth = np.column_stack([3.0 * times, 100 + 0.5 * times])
@@ -435,6 +455,8 @@ def test_non_increasing_times_raise_naming_time():
         ({"gate_probability": 1.0}, "gate_probability"),
         ({"gate_threshold": -1.0}, "gate_threshold"),
         ({"sigma_z": 0.0}, "sigma_z"),
+        ({"sigma_z_rel": -0.01}, "sigma_z_rel"),
+        ({"sigma_z_rel": float("nan")}, "sigma_z_rel"),
         ({"dt": -1.0}, "dt"),
         ({"size_smoothing": 0.0}, "size_smoothing"),
         ({"overlap_gate": 0.0}, "overlap_gate"),

@@ -220,10 +220,12 @@ FVESSEL = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "fves
 def test_fvessel_real_detections_keep_every_ship_with_few_ids():
     """FVessel Video-01 (MIT): the dataset authors' 1,822 detections of 5 ships at 1
     frame/s, tracked with VisualTracker's defaults and scored by TrackEval (IoU >= 0.5)
-    against the ground truth (docs/results/fvessel/). Measured (session 11): HOTA 0.594,
-    MOTA 0.802, IDF1 0.773, 3 ID switches, 11 track ids (the authors' tracker: 0.652,
-    0.867, 0.847, 2, 9). The bounds are those numbers with a margin, a regression guard
-    on real data, and every ship must be covered by a track for most of its frames."""
+    against the ground truth (docs/results/fvessel/). Measured (session 12, with the
+    size-relative box noise sigma_z_rel = 3 %): HOTA 0.672, MOTA 0.847, IDF1 0.907, 1 ID
+    switch, 7 track ids (session 11, σ_z alone: 0.594, 0.802, 0.773, 3, 11; the authors'
+    tracker: 0.652, 0.867, 0.847, 2, 9). The bounds are those numbers with a margin, a
+    regression guard on real data, and every ship must be covered by a track for most
+    of its frames."""
     gt = read_mot(FVESSEL / "Video-01_gt_tracking.txt")
     det = read_mot(FVESSEL / "Video-01_re_detection.txt")
     scans = [
@@ -232,6 +234,6 @@ def test_fvessel_real_detections_keep_every_ship_with_few_ids():
     vt = VisualTracker(detector=lambda *a, **k: None, horizon=False, fps=1.0)
     rows = tracks_to_rows(vt.track_detections(scans))
     m = mot_metrics(gt, rows, "iou", 0.5)
-    assert m.hota.hota > 0.57 and m.clear.mota > 0.77 and m.identity.idf1 > 0.74
-    assert m.clear.id_switches <= 5 and np.unique(rows[:, 1]).size <= 13
-    assert m.clear.fn <= 90  # of 1,709 truth boxes
+    assert m.hota.hota > 0.65 and m.clear.mota > 0.82 and m.identity.idf1 > 0.88
+    assert m.clear.id_switches <= 2 and np.unique(rows[:, 1]).size <= 9
+    assert m.clear.fn <= 70  # of 1,709 truth boxes

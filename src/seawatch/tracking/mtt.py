@@ -8,7 +8,7 @@ image (pixels) or as points on the sea (metres). One scan:
 1. **Predict** every track with its filter (nearly constant velocity model,
    ALGORITHMS.md §5.2: ``x = [x, y, vx, vy]``).
 2. **Gate** (Mahalanobis): ``d²_ij = y_ijᵀ S_i⁻¹ y_ij`` with ``y_ij = z_j − H x_i`` and
-   ``S_i = H P_i Hᵀ + R``; detection j may update track i only if
+   ``S_i = H P_i Hᵀ + R_i``; detection j may update track i only if
    ``d²_ij <= gamma = chi2.ppf(gate_probability, 2)``. Vectorised over the candidate
    pairs of a sort-and-sweep prefilter (``|y| <= sqrt(gamma tr S_i)`` per axis), so the
    cost grows with the pairs near each other rather than with tracks × detections.
@@ -42,7 +42,12 @@ image (pixels) or as points on the sea (metres). One scan:
    reused.
 
 Boxes ``(x, y, w, h)`` (top-left corner, width, height) are tracked by their centre;
-the size is smoothed alongside by exponential smoothing of (w, h).
+the size is smoothed alongside by exponential smoothing of (w, h). The measurement noise
+of a box centre may grow with the box: ``R_i = diag(max(σ_z, k w_i)², max(σ_z, k h_i)²)``
+with ``k = sigma_z_rel`` and the track's smoothed size ``(w_i, h_i)``: a detector places
+the edges of a large ship less surely than those of a small one (its masts, upper works
+or a neighbour's bow boxed with it or not), and the larger error wins, as in the
+occlusion tolerance ``max(σ_z, 15 %)``; ``k = 0``: ``R = σ_z² I``.
 
 Speed: with the default linear Kalman filter all tracks live in stacked arrays
 ``X (T, 4)``, ``P (T, 4, 4)`` and every step is a handful of batched numpy operations
@@ -271,6 +276,9 @@ class MultiTargetTracker:
         sigma_a: acceleration noise of the CV model [units/dt²] (discrete white-noise
             acceleration, ALGORITHMS.md §5.2).
         sigma_z: measurement noise of a detection position [px or m] (``R = σ_z² I``).
+        sigma_z_rel: boxes only — the box-centre noise of a large box, as a fraction k
+            of its width and height [–]: ``σ = max(σ_z, k · size)`` per axis (module
+            docstring, ``R_i``); 0 (default): ``R = σ_z² I`` for every track.
         sigma_v0: initial velocity uncertainty of a new track [units/dt], about the
             largest speed expected.
         gate_probability: probability that a true detection falls inside the gate
@@ -334,11 +342,13 @@ class MultiTargetTracker:
         occlusion: bool = False,
         filter_options: dict[str, Any] | None = None,
         coast_ratio: float | None = None,
+        sigma_z_rel: float = 0.0,
     ) -> None:
         self.dt = positive("dt", dt)
         self.sigma_a = positive("sigma_a", sigma_a, allow_zero=True)
         self.sigma_z = positive("sigma_z", sigma_z)
         self.sigma_v0 = positive("sigma_v0", sigma_v0)
+        self.sigma_z_rel = positive("sigma_z_rel", sigma_z_rel, allow_zero=True)
         if gate_threshold is None:
             p = in_range("gate_probability", gate_probability, 0.0, 1.0, lo_open=True, hi_open=True)
             self.gate = float(chi2.ppf(p, _DIM))
@@ -489,10 +499,10 @@ class MultiTargetTracker:
         valid = np.flatnonzero(np.all(np.isfinite(centres), axis=1))
         if sizes is not None:
             valid = valid[np.all(np.isfinite(sizes[valid]), axis=1)]
-        z = centres[valid]
 
         # 1. predict
         self._predict(dt)
+        z = centres[valid]
         # 2.–3. gate and assign
         boxes = sizes is not None and self.overlap_gate is not None
         zs = None if sizes is None else sizes[valid]
@@ -607,8 +617,17 @@ class MultiTargetTracker:
             self._X = np.stack([np.asarray(f.x, dtype=np.float64) for f in self._filters])
             self._P = np.stack([np.asarray(f.P, dtype=np.float64) for f in self._filters])
 
+    def _noise(self, rows: NDArray[np.int64] | slice = slice(None)) -> FloatArray:
+        """Measurement covariances ``R_i`` (n, 2, 2) of tracks ``rows`` (default: all):
+        ``diag(max(σ_z, sigma_z_rel · size)²)`` (module docstring)."""
+        R = np.broadcast_to(self.R, (self._X[rows].shape[0], _DIM, _DIM)).copy()
+        if self.sigma_z_rel > 0.0:
+            idx = np.arange(_DIM)
+            R[:, idx, idx] = np.maximum(self.sigma_z, self.sigma_z_rel * self._size[rows]) ** 2
+        return R
+
     def _innovation_covariance(self) -> FloatArray:
-        S = self.H @ self._P @ self.H.T + self.R
+        S = self.H @ self._P @ self.H.T + self._noise()
         return 0.5 * (S + np.swapaxes(S, 1, 2))
 
     def _cascade(
@@ -963,7 +982,7 @@ class MultiTargetTracker:
         if self.batched:
             if rows.size == 0:
                 return
-            H, R = self.H, self.R
+            H, R = self.H, self._noise(rows)
             x = self._X[rows]
             P = self._P[rows]
             PHt = P @ H.T  # (a, 4, 2)
@@ -978,8 +997,12 @@ class MultiTargetTracker:
         zz: list[FloatArray | None] = [None] * len(self._filters)
         for i, r in enumerate(rows):
             zz[int(r)] = z[i]
-        for f, zi in zip(self._filters, zz, strict=True):
-            f.update(zi)
+        Rs = self._noise() if self.sigma_z_rel > 0.0 else None
+        for k, (f, zi) in enumerate(zip(self._filters, zz, strict=True)):
+            if Rs is None or zi is None:
+                f.update(zi)
+            else:
+                f.update(zi, R=Rs[k])
         self._pull()
 
     def _compress(self, keep: NDArray[np.bool_]) -> None:

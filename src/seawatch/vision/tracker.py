@@ -98,6 +98,12 @@ class VisualTracker:
         memory: GL history length L of afkf/fkf (default 30).
         sigma_a: acceleration noise of the box centre [px/frame²] (Q0, §1.3).
         sigma_z: box-centre jitter of the detector [px] (R = σ_z² I).
+        sigma_z_rel: the jitter of a large box as a fraction k of its size:
+            ``R = diag(max(σ_z, k w)², max(σ_z, k h)²)`` with the track's smoothed size
+            (:class:`~seawatch.tracking.mtt.MultiTargetTracker`); 0: σ_z alone. The
+            default, 3 %, changes nothing for boxes under 67 px (2 px / 3 %) and gives a
+            270-px hull σ = 8 px: its track holds when the box loses a neighbour's bow
+            (a 40-px jump of its centre) or its upper works (FVessel, README).
         sigma_v0: initial velocity std of a new track [px/frame].
         gate_probability: gate of the association (χ²₂ probability).
         confirm_m, confirm_n: M-of-N confirmation.
@@ -138,6 +144,7 @@ class VisualTracker:
         *,
         sigma_a: float = 0.5,
         sigma_z: float = 2.0,
+        sigma_z_rel: float = 0.03,
         sigma_v0: float = 5.0,
         gate_probability: float = 0.999,
         confirm_m: int = 3,
@@ -187,6 +194,7 @@ class VisualTracker:
             confirmed_first=confirmed_first,
             occlusion=occlusion,
             filter_options=opts or None,
+            sigma_z_rel=sigma_z_rel,
         )
         self._factory = factory
         self.mtt = MultiTargetTracker(factory, **self._mtt_args)
