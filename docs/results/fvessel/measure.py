@@ -9,7 +9,8 @@ the occlusion handling on; nothing tuned to these data, ``fps`` = 1), and every 
 is scored with :func:`seawatch.metrics.mot_metrics` (TrackEval; IoU >= 0.5) against the
 ground truth. Two readings of seawatch's output: every confirmed track row (coasting
 predictions included), and only the rows a detection updated (as the authors' file,
-one row per detection). Also the AFKF with σ_z = 4 and 8 px instead of the default 2 px.
+one row per detection). Also the AFKF with σ_z alone (``sigma_z_rel`` = 0, the box noise
+before session 12) and with σ_z = 4 and 8 px instead of the default 2 px.
 Writes ``fvessel.json`` beside this file.
 
     .venv/bin/python docs/results/fvessel/measure.py
@@ -71,6 +72,7 @@ def main() -> int:
         "authors_tracker": _scores(gt, read_mot(DATA / "Video-01_re_tracking.txt")),
     }
     runs = [(name, {}) for name in FILTERS]
+    runs += [("afkf", {"sigma_z_rel": 0.0})]
     runs += [("afkf", {"sigma_z": sz}) for sz in SIGMA_Z_SWEEP]
     for name, options in runs:
         vt = VisualTracker(
@@ -80,7 +82,7 @@ def main() -> int:
         per = vt.track_detections(scans)
         seconds = time.perf_counter() - t0
         updated = [p[p[:, 7] == 0] for p in per]
-        key = name if not options else f"{name} sigma_z={options['sigma_z']:g}"
+        key = " ".join([name] + [f"{k}={v:g}" for k, v in options.items()])
         result[key] = {
             "all_rows": _scores(gt, tracks_to_rows(per)),
             "detection_rows": _scores(gt, tracks_to_rows(updated)),
