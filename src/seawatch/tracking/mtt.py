@@ -619,11 +619,13 @@ class MultiTargetTracker:
 
     def _noise(self, rows: NDArray[np.int64] | slice = slice(None)) -> FloatArray:
         """Measurement covariances ``R_i`` (n, 2, 2) of tracks ``rows`` (default: all):
-        ``diag(max(σ_z, sigma_z_rel · size)²)`` (module docstring)."""
-        R = np.broadcast_to(self.R, (self._X[rows].shape[0], _DIM, _DIM)).copy()
-        if self.sigma_z_rel > 0.0:
-            idx = np.arange(_DIM)
-            R[:, idx, idx] = np.maximum(self.sigma_z, self.sigma_z_rel * self._size[rows]) ** 2
+        ``diag(max(σ_z, sigma_z_rel · size)²)`` (module docstring); the (2, 2) ``R``
+        itself, which broadcasts, when ``sigma_z_rel`` is 0."""
+        if self.sigma_z_rel == 0.0:
+            return self.R
+        R = np.zeros((self._X[rows].shape[0], _DIM, _DIM))
+        idx = np.arange(_DIM)
+        R[:, idx, idx] = np.maximum(self.sigma_z, self.sigma_z_rel * self._size[rows]) ** 2
         return R
 
     def _innovation_covariance(self) -> FloatArray:
