@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import cv2
 import pytest
 
 from seawatch.scenarios import ship_video
@@ -28,6 +29,10 @@ def test_record_shapes_and_sweep(tmp_path):
     assert res.extra["best_order"] in (0.8, 1.0)
     assert (tmp_path / "cle.csv").exists() and (tmp_path / "small" / "video.mp4").exists()
     assert res.extra["crf"] == 20
+    # the figures: a PNG of two panels with drawn content, listed among the outputs
+    png = cv2.imread(str(tmp_path / "cle.png"))
+    assert png is not None and png.shape == (462, 1210, 3) and png.std() > 10
+    assert tmp_path / "cle.png" in res.outputs
 
 
 def test_bad_arguments_raise():
@@ -48,6 +53,7 @@ def test_chunked_units_give_the_records_of_one_run(tmp_path):
     split = ship_video.merge(parts, 2, 3, tmp_path, **opts)
     assert split.results == whole.results and split.extra == whole.extra
     assert (tmp_path / "cle.csv").read_text().count("\n") == 1 + 2 * 3
+    assert cv2.imread(str(tmp_path / "cle.png")) is not None
     with pytest.raises(ValueError, match="payloads"):
         ship_video.merge(parts[:1], 2, 3, **opts)
     with pytest.raises(ValueError, match="indices"):

@@ -19,7 +19,9 @@ under a pixel, so that case is rendered at ``small_scale`` × the frame size (de
 
 The paper's claims checked (``extra`` of the result): ``ordering`` per case, whether
 ``cle_percent`` of afkf <= fkf <= kf; ``best_order`` of the sweep and whether it is
-interior (neither end of the swept range).
+interior (neither end of the swept range). With an output folder the figures are drawn
+too (:func:`plot_cle`): ``cle.png``, the error per case and filter (the paper's Tables
+1–2) beside the error against the fractional order (its order figure).
 """
 
 from __future__ import annotations
@@ -41,7 +43,7 @@ from seawatch.synth import render_case
 from seawatch.synth.cases import CASES
 from seawatch.vision.tracker import FILTERS, VisualTracker, tracks_to_rows
 
-__all__ = ["ORDERS", "chunk", "merge", "run", "track_case", "unit_costs", "units"]
+__all__ = ["ORDERS", "chunk", "merge", "plot_cle", "run", "track_case", "unit_costs", "units"]
 
 ORDERS: tuple[float, ...] = (0.7, 0.8, 0.9, 0.95, 1.0)
 """Fractional orders of the sweep (ALGORITHMS.md §1.3: tunable 0.8–1.0, default 0.95)."""
@@ -90,12 +92,6 @@ def _names(cases: Sequence[str] | None) -> list[str]:
     return names
 
 
-def _runs(runs: object) -> int:
-    if isinstance(runs, bool) or not isinstance(runs, int) or runs < 1:
-        raise ValueError(f"runs: expected an integer >= 1, got {runs!r}")
-    return runs
-
-
 def _orders(orders: Sequence[float]) -> list[float]:
     alphas = [float(a) for a in orders]
     if any(not (a > 0) for a in alphas):
@@ -105,7 +101,7 @@ def _orders(orders: Sequence[float]) -> list[float]:
 
 def units(runs: int = 1, cases: Sequence[str] | None = None, **_: Any) -> int:
     """Parallel protocol: one work unit per rendering (run × case)."""
-    return _runs(runs) * len(_names(cases))
+    return integer("runs", runs, 1) * len(_names(cases))
 
 
 def unit_costs(
@@ -119,7 +115,7 @@ def unit_costs(
     small case is ``small_scale``² larger and is tracked once more per swept order)."""
     names = _names(cases)
     one = [small_scale**2 * (1.0 + 0.1 * len(orders)) if n == SWEEP_CASE else 1.0 for n in names]
-    return np.tile(np.array(one), _runs(runs))
+    return np.tile(np.array(one), integer("runs", runs, 1))
 
 
 def _unit_options(
@@ -238,7 +234,7 @@ def run(
         Run on Dask (``--workers``, :mod:`seawatch.scenarios.parallel`), the same records
         come from :func:`chunk` and :func:`merge`, without the footage.
     """
-    n_runs = _runs(runs)
+    n_runs = integer("runs", runs, 1)
     names = _names(cases)
     opts = _unit_options(width, height, duration, orders, small_scale, fps, crf)
     with contextlib.ExitStack() as stack:
@@ -262,7 +258,9 @@ def run(
                 table.flush()
             if progress is not None:
                 progress(len(done), total)
-    outputs = [] if out_dir is None else [Path(out_dir) / "cle.csv"]
+    outputs: list[Path] = []
+    if out_dir is not None:
+        outputs = [Path(out_dir) / "cle.csv", plot_cle(done, Path(out_dir) / "cle.png")]
     return _result(done, names, n_runs, seed, outputs)
 
 
@@ -287,7 +285,7 @@ def chunk(
     names = _names(cases)
     opts = _unit_options(width, height, duration, orders, small_scale, fps, crf)
     idx = [int(i) for i in indices]
-    n = _runs(runs) * len(names)
+    n = integer("runs", runs, 1) * len(names)
     if not idx or idx != sorted(set(idx)) or idx[0] < 0 or idx[-1] >= n:
         raise ValueError(f"indices: expected increasing units in 0 … {n - 1}, got {indices!r}")
     out = []
@@ -311,7 +309,7 @@ def merge(
     unit order (the parallel protocol of :mod:`seawatch.scenarios.parallel`)."""
     names = _names(cases)
     done = [u for p in payloads for u in p]
-    if len(done) != _runs(runs) * len(names):
+    if len(done) != integer("runs", runs, 1) * len(names):
         raise ValueError(f"payloads: expected {runs * len(names)} units, got {len(done)}")
     outputs: list[Path] = []
     if out_dir is not None:
@@ -322,8 +320,67 @@ def merge(
             tw.writerow(_HEADER)
             for unit in done:
                 tw.writerows(_csv_rows(unit))
-        outputs.append(root / "cle.csv")
+        outputs += [root / "cle.csv", plot_cle(done, root / "cle.png")]
     return _result(done, names, runs, seed, outputs)
+
+
+def plot_cle(done: Sequence[dict[str, Any]], path: str | Path) -> Path:
+    """The experiment's figures in one PNG: (a) the centre location error [% of the truth
+    box diagonal] per case for the adaptive fractional, fractional and integer-order KF
+    (bars: the mean over the renderings, dots: each rendering; log scale) — the paper's
+    Tables 1–2; (b) the AFKF's error on the small case against the fractional order
+    (dots: each rendering, line: their mean; the default order marked) — its order
+    figure. ``done``: the units of :func:`run` / :func:`chunk`."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    cases = list(dict.fromkeys(u["case"] for u in done))
+    per: dict[tuple[str, str], list[float]] = {}
+    sweep: dict[float, list[float]] = {}
+    for unit in done:
+        for est, a, _px, pct, _prec in unit["rows"]:
+            if a is None:
+                per.setdefault((unit["case"], est), []).append(pct)
+            else:
+                sweep.setdefault(float(a), []).append(pct)
+    fig = Figure(figsize=(11.0, 4.2), dpi=110)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(1, 2, 1)
+    colours = {"afkf": "#d62728", "fkf": "#1f77b4", "kf": "#7f7f7f"}
+    width = 0.27
+    for k, est in enumerate(FILTERS):
+        x = np.arange(len(cases)) + (k - 1) * width
+        vals = [np.asarray(per.get((c, est), [np.nan]), dtype=float) for c in cases]
+        ax.bar(x, [np.nanmean(v) for v in vals], width, color=colours[est], label=est)
+        for xi, v in zip(x, vals, strict=True):
+            if v.size > 1:
+                ax.plot(np.full(v.size, xi), v, "o", color="black", ms=2.5)
+    ax.axhline(2.0, color="black", lw=0.8, ls="--", label="2 % (issue 6 target)")
+    ax.set_yscale("log")
+    ax.set_xticks(np.arange(len(cases)), cases, rotation=30, ha="right")
+    ax.set_ylabel("centre location error [% of box diagonal]")
+    ax.set_title("(a) per case and filter")
+    ax.grid(True, axis="y", which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    ax = fig.add_subplot(1, 2, 2)
+    if sweep:
+        orders = sorted(sweep)
+        for a in orders:
+            ax.plot(np.full(len(sweep[a]), a), sweep[a], "o", color="#d62728", ms=3, alpha=0.6)
+        ax.plot(orders, [np.nanmean(sweep[a]) for a in orders], "-", color="#d62728",
+                label="afkf, mean")  # fmt: skip
+        ax.axvline(0.95, color="black", lw=0.8, ls=":", label="default order 0.95")
+        ax.legend(fontsize=8)
+    else:
+        ax.text(0.5, 0.5, "no order sweep (small case not run)", ha="center",
+                transform=ax.transAxes)  # fmt: skip
+    ax.set_xlabel("fractional order α")
+    ax.set_ylabel("centre location error [% of box diagonal]")
+    ax.set_title(f"(b) {SWEEP_CASE} case: error against the order")
+    ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path)
+    return Path(path)
 
 
 def _result(
