@@ -64,7 +64,7 @@ from typing import Any
 
 import numpy as np
 
-from seawatch._validation import FloatArray
+from seawatch._validation import FloatArray, integer
 from seawatch.synth.render import RENDER_VERSION
 
 __all__ = [
@@ -189,8 +189,7 @@ def render_clip(
         folder: the clip's folder; None: a folder per parameter set under the system's
             temporary directory, kept between runs.
     """
-    if isinstance(frames, bool) or not isinstance(frames, int | np.integer) or frames < 2:
-        raise ValueError(f"frames: expected an integer >= 2, got {frames!r}")
+    frames = integer("frames", frames, 2)
     for name, value in (("width", width), ("height", height)):
         if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 64:
             raise ValueError(f"{name}: expected an integer >= 64 px, got {value!r}")
@@ -494,8 +493,7 @@ def run(
             system's temporary directory.
         progress: ``progress(label)`` before each step.
     """
-    if isinstance(repeats, bool) or not isinstance(repeats, int | np.integer) or repeats < 1:
-        raise ValueError(f"repeats: expected an integer >= 1, got {repeats!r}")
+    repeats = integer("repeats", repeats, 1)
     say = progress or (lambda _msg: None)
     say("render")
     clip = render_clip(frames, width=width, height=height, fps=fps, seed=seed, folder=folder)

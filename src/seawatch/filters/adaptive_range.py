@@ -58,7 +58,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from seawatch._validation import FloatArray, as_float_array, positive
+from seawatch._validation import FloatArray, as_float_array, integer, positive
 from seawatch.filters.kalman import KalmanFilter
 from seawatch.filters.result import FilterResult
 from seawatch.models.kinematic import (
@@ -524,6 +524,4 @@ def _check_source(source: str) -> StatisticSource:
 
 
 def _check_window(window: int) -> int:
-    if isinstance(window, bool) or not isinstance(window, int | np.integer) or window < 1:
-        raise ValueError(f"window: expected an integer >= 1, got {window!r}")
-    return int(window)
+    return integer("window", window, 1)

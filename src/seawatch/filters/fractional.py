@@ -121,8 +121,7 @@ def fractional_cv_matrix(dim: int, dt: float) -> FloatArray:
     for ``dim = 2``), so that order 1 gives exactly ``A - Y_1 = A + I = F_CV``. ``dt`` is
     the frame period in the time unit of the velocities (1.0: velocities in px/frame).
     """
-    if isinstance(dim, bool) or not isinstance(dim, int | np.integer) or not 1 <= dim <= 3:
-        raise ValueError(f"dim: expected 1, 2 or 3 spatial axes, got {dim!r}")
+    dim = integer("dim", dim, 1, 3)
     T = positive("dt", dt)
     return np.kron(np.array([[0.0, T], [0.0, 0.0]]), np.eye(int(dim)))
 

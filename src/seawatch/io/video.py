@@ -81,6 +81,8 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from seawatch._validation import integer
+
 __all__ = [
     "IMAGE_EXTENSIONS",
     "Frame",
@@ -265,8 +267,7 @@ class VideoReader:
         timeout: float = 10.0,
         backend: Literal["auto", "pyav", "opencv"] = "auto",
     ) -> None:
-        if isinstance(step, bool) or not isinstance(step, int | np.integer) or step < 1:
-            raise ValueError(f"step: expected an integer >= 1, got {step!r}")
+        step = integer("step", step, 1)
         if not (isinstance(start, int | float) and math.isfinite(start) and start >= 0):
             raise ValueError(f"start: expected a finite time >= 0 s, got {start!r}")
         if end is not None and not (isinstance(end, int | float) and end > start):

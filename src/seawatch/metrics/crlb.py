@@ -55,7 +55,15 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from seawatch._validation import FloatArray, as_float_array, covariance, finite, matrix, positive
+from seawatch._validation import (
+    FloatArray,
+    as_float_array,
+    covariance,
+    finite,
+    integer,
+    matrix,
+    positive,
+)
 from seawatch.geometry.sea import EARTH_RADIUS
 from seawatch.models.angles import SeaSurfaceAngles
 from seawatch.models.kinematic import constant_acceleration, constant_velocity
@@ -336,8 +344,7 @@ def pcrb_linear(
         elif arr.ndim != 2:
             raise ValueError(f"{name}: expected a matrix or one matrix per step, got {arr.shape}")
     if steps is not None:
-        if isinstance(steps, bool) or not isinstance(steps, int | np.integer) or steps < 1:
-            raise ValueError(f"steps: expected an integer >= 1, got {steps!r}")
+        steps = integer("steps", steps, 1)
         if T is not None and int(steps) != T:
             raise ValueError(f"steps: {steps} does not match the {T} per-step matrices")
         T = int(steps)

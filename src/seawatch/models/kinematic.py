@@ -12,14 +12,13 @@ from typing import Literal
 
 import numpy as np
 
-from seawatch._validation import FloatArray, positive
+from seawatch._validation import FloatArray, integer, positive
 
 NoiseKind = Literal["discrete", "continuous"]
 
 
 def _check(dim: int, dt: float, sigma: float, sigma_name: str) -> tuple[int, float, float]:
-    if isinstance(dim, bool) or not isinstance(dim, int | np.integer) or not 1 <= int(dim) <= 3:
-        raise ValueError(f"dim: expected 1, 2 or 3 spatial axes, got {dim!r}")
+    dim = integer("dim", dim, 1, 3)
     return int(dim), positive("dt", dt), positive(sigma_name, sigma, allow_zero=True)
 
 

@@ -150,7 +150,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq
 
-from seawatch._validation import FloatArray, as_float_array, covariance, matrix, positive
+from seawatch._validation import FloatArray, as_float_array, covariance, integer, matrix, positive
 from seawatch.filters.adaptive_range import (
     STANDARD_GRAVITY,
     AdaptiveRangeFilter,
@@ -356,8 +356,7 @@ class AirRangeMeasurements:
 
 def _run_noise(indices: Sequence[int], seed: int, frames: int) -> FloatArray:
     """Standard normals (B, frames); run i from ``SeedSequence(seed, spawn_key=(i,))``."""
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise ValueError(f"seed: expected a non-negative integer, got {seed!r}")
+    seed = integer("seed", seed, 0)
     out = np.empty((len(indices), frames))
     for b, i in enumerate(indices):
         ss = np.random.SeedSequence(int(seed), spawn_key=(int(i),))
@@ -382,8 +381,7 @@ def simulate(
     run's numbers do not depend on how the runs are split into blocks or workers.
     """
     runs = _check_runs(runs)
-    if isinstance(start, bool) or not isinstance(start, int | np.integer) or start < 0:
-        raise ValueError(f"start: expected a non-negative integer, got {start!r}")
+    start = integer("start", start, 0)
     return _simulate_runs(range(int(start), int(start) + runs), seed, truth, sigma_l, focal, size)
 
 
@@ -1081,9 +1079,7 @@ def _write_demo(result: AirRangeResult, out_dir: Path | str) -> DemoResult:
 
 
 def _check_runs(runs: int) -> int:
-    if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
-        raise ValueError(f"runs: expected an integer >= 1, got {runs!r}")
-    return int(runs)
+    return integer("runs", runs, 1)
 
 
 def merge(

@@ -116,6 +116,7 @@ from numba import njit
 from numpy.typing import ArrayLike, NDArray
 from scipy.special import lambertw
 
+from seawatch._validation import integer
 from seawatch.scenarios.base import ExperimentResult, ProgressCallback, record
 from seawatch.tracking.gate_tbd import DEFAULT_LINEARITY_THRESHOLD, GateTBD
 
@@ -949,9 +950,7 @@ def _z_paper(row: dict[str, Any]) -> float:
 def _check_runs(runs: int | None) -> int:
     if runs is None:
         return DEFAULT_RUNS
-    if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
-        raise ValueError(f"runs: expected an integer >= 1, got {runs!r}")
-    return int(runs)
+    return integer("runs", runs, 1)
 
 
 PARALLEL_MIN_COST = 30_000.0
@@ -1076,8 +1075,7 @@ def chunk(
         progress: ``progress(done, total)`` after each Table 2 row, Table 1 gate size and
             case of the chunk.
     """
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise ValueError(f"seed: expected a non-negative integer, got {seed!r}")
+    seed = integer("seed", seed, 0)
     n_runs, _, plan = _plan(table, runs, clutter_levels, variant)
     idx = list(indices)
     if not idx or any(not 0 <= i < len(plan) for i in idx):

@@ -72,6 +72,7 @@ from typing import Any
 
 import numpy as np
 
+from seawatch._validation import integer
 from seawatch.scenarios import registry
 from seawatch.scenarios.base import ExperimentResult, ProgressCallback
 
@@ -137,9 +138,7 @@ def _check_options(name: str, options: dict[str, Any]) -> None:
 def _units(mod: ModuleType, runs: int | None, options: dict[str, Any]) -> int:
     if hasattr(mod, "units"):
         return int(mod.units(runs, **options))
-    if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
-        raise ValueError(f"runs: expected an integer >= 1, got {runs!r}")
-    return int(runs)
+    return integer("runs", runs, 1)
 
 
 def default_workers() -> int:
@@ -148,12 +147,6 @@ def default_workers() -> int:
         return max(1, len(os.sched_getaffinity(0)))
     except AttributeError:  # pragma: no cover - not on Linux
         return max(1, os.cpu_count() or 1)
-
-
-def _positive_int(name: str, value: object) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
-        raise ValueError(f"{name}: expected an integer >= 1, got {value!r}")
-    return int(value)
 
 
 # ------------------------------------------------------------------------------------
@@ -185,12 +178,12 @@ def plan_chunks(
     Returns:
         The chunks as ranges, in order, covering every unit once.
     """
-    n = _positive_int("units", units)
-    a = _positive_int("align", align)
+    n = integer("units", units, 1)
+    a = integer("align", align, 1)
     if chunk is not None:
-        size = -(-_positive_int("chunk", chunk) // a) * a
+        size = -(-integer("chunk", chunk, 1) // a) * a
         return [range(lo, min(lo + size, n)) for lo in range(0, n, size)]
-    want = _positive_int("tasks", tasks)
+    want = integer("tasks", tasks, 1)
     if costs is not None:
         c = np.asarray(costs, dtype=np.float64)
         if c.shape != (n,) or not np.all(np.isfinite(c)) or np.any(c < 0):
@@ -322,7 +315,7 @@ def dask_client(
         with _remote_client(scheduler, timeout) as client:
             yield client
     else:
-        n = default_workers() if workers is None else _positive_int("workers", workers)
+        n = default_workers() if workers is None else integer("workers", workers, 1)
         with _local_client(n) as client:
             yield client
 
@@ -404,9 +397,9 @@ def run_experiment(
     mod = _module(name)
     _check_options(name, options)
     if workers is not None:
-        workers = _positive_int("workers", workers)
+        workers = integer("workers", workers, 1)
     if chunk is not None:
-        chunk = _positive_int("chunk", chunk)
+        chunk = integer("chunk", chunk, 1)
     if not supports_parallel(name):
         if scheduler is None and workers in (None, 1):
             kwargs: dict[str, Any] = {"seed": seed, "out_dir": out_dir, "progress": progress}
@@ -677,9 +670,9 @@ def sweep(
         grid[key] = vals
     _check_options(name, options)
     if workers is not None:
-        workers = _positive_int("workers", workers)
+        workers = integer("workers", workers, 1)
     if chunk is not None:
-        chunk = _positive_int("chunk", chunk)
+        chunk = integer("chunk", chunk, 1)
     points = [dict(zip(grid, combo, strict=True)) for combo in itertools.product(*grid.values())]
     results: dict[int, SweepPoint] = {}
     writer = _SweepWriter(Path(out_dir) / SWEEP_CSV, list(grid)) if out_dir is not None else None

@@ -135,7 +135,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from seawatch._validation import FloatArray
+from seawatch._validation import FloatArray, integer
 from seawatch.filters import DiffuseRLS, ExtendedKalmanFilter, UnscentedKalmanFilter
 from seawatch.geometry import (
     DEFAULT_REFRACTION,
@@ -385,15 +385,11 @@ def _number(name: str, value: object, lo: float, hi: float, *, lo_open: bool = F
 
 
 def _runs(runs: object) -> int:
-    if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
-        raise ValueError(f"runs: expected an integer >= 1, got {runs!r}")
-    return int(runs)
+    return integer("runs", runs, 1)
 
 
 def _seed(seed: object) -> int:
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise ValueError(f"seed: expected a non-negative integer, got {seed!r}")
-    return int(seed)
+    return integer("seed", seed, 0)
 
 
 def _load(ais: str | Path | AisTable | None) -> AisTable:

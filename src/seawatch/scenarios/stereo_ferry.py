@@ -188,7 +188,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from seawatch._validation import FloatArray, as_float_array, positive
+from seawatch._validation import FloatArray, as_float_array, integer, positive
 from seawatch.camera import SEED003_CALIBRATION, triangulate, triangulation_covariance
 from seawatch.filters import KalmanFilter, StrongTrackingKalmanFilter
 from seawatch.models.kinematic import constant_velocity, position_measurement
@@ -606,8 +606,7 @@ def stereo_speed_std(
     Returns:
         σ_v [m/s] (0.0265 for experiment 1, 0.0355 for experiment 2 at 0.5 px).
     """
-    if isinstance(frames, bool) or not isinstance(frames, int | np.integer) or frames < 2:
-        raise ValueError(f"frames: expected an integer >= 2, got {frames!r}")
+    frames = integer("frames", frames, 2)
     geo = ferry_geometry() if geometry is None else geometry
     t = np.arange(int(frames)) * DT_S
     w = 1.0 / along_track_variance(geo, experiment.speed * t, sigma_px)
@@ -801,8 +800,7 @@ def _generators(seed: int, experiment: int, indices: Sequence[int]) -> list[np.r
 
     The same streams as ``SeedSequence(seed).spawn(2)[e − 1].spawn(runs)[i]``.
     """
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise ValueError(f"seed: expected a non-negative integer, got {seed!r}")
+    seed = integer("seed", seed, 0)
     return [
         np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(experiment - 1, int(i))))
         for i in indices
@@ -1080,9 +1078,7 @@ def ordering(
 
 
 def _check_runs(runs: int) -> int:
-    if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
-        raise ValueError(f"runs: expected an integer >= 1, got {runs!r}")
-    return int(runs)
+    return integer("runs", runs, 1)
 
 
 def _numbers(experiment: int | None) -> list[int]:

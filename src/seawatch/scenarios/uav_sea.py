@@ -149,7 +149,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from seawatch._validation import FloatArray, positive
+from seawatch._validation import FloatArray, integer, positive
 from seawatch.filters import (
     DiffuseRLS,
     ExtendedKalmanFilter,
@@ -406,9 +406,7 @@ class Measurements:
 
 
 def _check_runs(runs: object) -> int:
-    if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
-        raise ValueError(f"runs: expected an integer >= 1, got {runs!r}")
-    return int(runs)
+    return integer("runs", runs, 1)
 
 
 def simulate(
@@ -439,8 +437,7 @@ def simulate(
         Measurements of shape (B, T, ...), T = 713.
     """
     B = _check_runs(runs)
-    if isinstance(start, bool) or not isinstance(start, int | np.integer) or start < 0:
-        raise ValueError(f"start: expected a non-negative integer, got {start!r}")
+    start = integer("start", start, 0)
     setup = _Setup(
         positive("height", height),
         positive("sigma_azimuth", sigma_azimuth),
@@ -451,8 +448,7 @@ def simulate(
 
 def _simulate_runs(runs: np.ndarray, seed: int, setup: _Setup) -> Measurements:
     """:func:`simulate` for the global run indices ``runs`` (B,)."""
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise ValueError(f"seed: expected a non-negative integer, got {seed!r}")
+    seed = integer("seed", seed, 0)
     B = runs.size
     nominal = nominal_trajectory(setup.height)
     T = nominal.time.size

@@ -55,7 +55,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.stats import chi2
 
-from seawatch._validation import FloatArray, as_float_array, covariance, in_range, positive
+from seawatch._validation import FloatArray, as_float_array, covariance, in_range, integer, positive
 from seawatch.io.ais import MAX_GAP, AisTable, interpolate_track, tracks
 from seawatch.tracking.mtt import gnn_assign
 
@@ -394,9 +394,11 @@ class AisAssociator:
         self.sigma_ais_velocity = positive("sigma_ais_velocity", sigma_ais_velocity)
         self.max_extrapolation = positive("max_extrapolation", max_extrapolation, allow_zero=True)
         self.max_gap = positive("max_gap", max_gap)
-        self.min_frames = _count("min_frames", min_frames)
+        self.min_frames = integer("min_frames", min_frames, 1)
         self.switch_frames = (
-            3 * self.min_frames if switch_frames is None else _count("switch_frames", switch_frames)
+            3 * self.min_frames
+            if switch_frames is None
+            else integer("switch_frames", switch_frames, 1)
         )
         self.majority = in_range("majority", majority, 0.5, 1.0, lo_open=True)
         self.continuity = positive("continuity", continuity, allow_zero=True)
@@ -773,12 +775,6 @@ def _mahalanobis2(y: FloatArray, S: FloatArray) -> tuple[FloatArray, FloatArray]
         )
     y0, y1 = y[..., 0], y[..., 1]
     return (d * y0 * y0 - 2.0 * b * y0 * y1 + a * y1 * y1) / det, np.log(det)
-
-
-def _count(name: str, value: Any) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise ValueError(f"{name}: expected an integer >= 1, got {value!r}")
-    return int(value)
 
 
 def _finite_time(time: Any) -> float:

@@ -149,7 +149,6 @@ and the EKF is the cheaper and simpler of the two.
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -158,7 +157,7 @@ from numba import njit
 from numpy.typing import ArrayLike, NDArray
 from scipy.stats import chi2
 
-from seawatch._validation import FloatArray, as_float_array, covariance, in_range, positive
+from seawatch._validation import FloatArray, as_float_array, covariance, in_range, integer, positive
 from seawatch.filters.diffuse_rls import DiffuseRLS, DiffuseRLSBank
 from seawatch.geometry.sea import DEFAULT_REFRACTION, EARTH_RADIUS
 
@@ -809,12 +808,6 @@ def _flag(name: str, value: object) -> bool:
     return bool(value)
 
 
-def _whole(name: str, value: object, lo: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or int(value) < lo:
-        raise ValueError(f"{name}: expected an integer >= {lo}, got {value!r}")
-    return int(value)
-
-
 @dataclass(frozen=True)
 class _Fix:
     """Point-wise positions of k measurements (``_pointwise``)."""
@@ -932,7 +925,7 @@ class WorldTracker:
         self.max_range = None if max_range is None else positive("max_range", max_range)
         self.init_margin = positive("init_margin", init_margin, allow_zero=True)
         self.velocity_window = positive("velocity_window", velocity_window)
-        self.ar_order = _whole("ar_order", ar_order, 1)
+        self.ar_order = integer("ar_order", ar_order, 1)
         self.ar_increments = _flag("ar_increments", ar_increments)
         self.forgetting = in_range("forgetting", forgetting, 0.0, 1.0, lo_open=True)
         self.frame_interval = (

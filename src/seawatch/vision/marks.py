@@ -43,7 +43,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
-from seawatch._validation import FloatArray, positive
+from seawatch._validation import FloatArray, integer, positive
 from seawatch.vision.planes import image_array
 
 __all__ = [
@@ -101,12 +101,6 @@ def grayscale(image: ArrayLike) -> NDArray:
     if arr.dtype != np.uint8:  # one compiled kernel for 8-bit video, one for the rest
         arr = arr.astype(np.float64, copy=False)
     return np.ascontiguousarray(arr)
-
-
-def _half_size(name: str, value: int, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
-        raise ValueError(f"{name}: expected an integer >= {minimum}, got {value!r}")
-    return int(value)
 
 
 def _border(border: str) -> bool:
@@ -326,8 +320,8 @@ Detection = tuple[NDArray[np.uint8], FloatArray, NDArray[np.int64]]
 def _cfar(
     x: NDArray, train: int, guard: int, alpha: float, squared: bool, border: str
 ) -> Detection:
-    t = _half_size("train", train, 1)
-    g = _half_size("guard", guard, 0)
+    t = integer("train", train, 1)
+    g = integer("guard", guard, 0)
     a = positive("alpha", alpha)
     clip = _border(border)
     _check_window(x.shape, t + g, clip, "CFAR")
@@ -348,7 +342,7 @@ def _adaptive(
     ho = int(window) // 2
     hg = -1
     if guard is not None:
-        hg = _half_size("guard", guard, 0)
+        hg = integer("guard", guard, 0)
         if hg >= ho:
             raise ValueError(
                 f"guard: the guard box ({2 * hg + 1} px) must be smaller than the window "
@@ -561,10 +555,10 @@ def _components(
 
 
 def _areas(min_area: int, max_area: int | None) -> tuple[int, int | None]:
-    lo = _half_size("min_area", min_area, 1)
+    lo = integer("min_area", min_area, 1)
     if max_area is None:
         return lo, None
-    hi = _half_size("max_area", max_area, 1)
+    hi = integer("max_area", max_area, 1)
     if hi < lo:
         raise ValueError(f"max_area: expected >= min_area = {lo}, got {hi}")
     return lo, hi
