@@ -307,32 +307,52 @@ def test_rendered_footage_horizon_matches_the_renderer_truth(tmp_path: Path):
         assert abs((est.y1 - est.y0) - (t1 - t0)) < 0.1, (frame.index, est.y0, est.y1, t0, t1)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="known failure (issue 6): a coast on the horizon over part of the width pulls "
-    "the line onto the top of the land (rendered crossing, seed 1: the right end 27-32 px "
-    "high in every frame, confidence about 0.6); the coast's base is a weak edge of the "
-    "other polarity and is not among the line candidates",
-)
-def test_rendered_coast_on_part_of_the_horizon_does_not_tilt_the_line(tmp_path: Path):
-    """One second of the rendered crossing case (960 × 540, seed 1): a coastline sits on
-    the horizon over the right two-thirds of the width, open sky over the sea on the
-    left. The sea horizon is the sky/sea edge on the left and the land's water line on
-    the right, one straight line (horizon.csv); both ends within 2 px in every frame."""
+def _coast_clip_errors(tmp_path: Path, seed: int) -> list[tuple[int, float, float]]:
+    """One second of the rendered crossing case (960 × 540) with rendering ``seed``:
+    (frame, |Δy| at the left end, at the right end) [px] of detect_horizon's line against
+    the renderer's horizon.csv."""
     import csv
 
     from seawatch.io.video import VideoReader
     from seawatch.synth import render_case
 
-    render_case("crossing", tmp_path, duration=1.0, width=960, height=540, seed=1)
+    render_case("crossing", tmp_path, duration=1.0, width=960, height=540, seed=seed)
     with (tmp_path / "horizon.csv").open() as fh:
         truth = [(float(r["y0"]), float(r["y1"])) for r in csv.DictReader(fh)]
     frames = list(VideoReader(tmp_path / "video.mp4"))
     assert len(frames) == len(truth) == 25
+    out = []
     for frame, (t0, t1) in zip(frames, truth, strict=True):
         est = detect_horizon(frame.image)
         assert est.found
-        assert abs(est.y0 - t0) < 2.0 and abs(est.y1 - t1) < 2.0, (frame.index, est, t0, t1)
+        out.append((frame.index, abs(est.y0 - t0), abs(est.y1 - t1)))
+    return out
+
+
+def test_rendered_coast_on_part_of_the_horizon_does_not_tilt_the_line(tmp_path: Path):
+    """Rendered crossing, seed 1: a coastline sits on the horizon over the right
+    two-thirds of the width, open sky over the sea on the left. The sea horizon is the
+    sky/sea edge on the left and the land's water line on the right, one straight line.
+    The coarse line joins the sky/sea edge to the top of the land (the right end 27–32 px
+    high, its refined fit holding under half the bins); step 6b's straightest edge among
+    the bins (the sky/sea part) is the better sea horizon by the region test and replaces
+    it: both ends within 0.5 px in every frame (measured 0.04–0.4 px)."""
+    for k, e0, e1 in _coast_clip_errors(tmp_path, seed=1):
+        assert e0 < 0.5 and e1 < 0.5, (k, e0, e1)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="known failure (issue 6): rendered crossing, seed 0: the coarse line follows "
+    "the top of a coast over the left two-thirds and meets the sky/sea edge only at the "
+    "right end, so the sea horizon on the left lies outside the refinement's search "
+    "window (left end 26-30 px high)",
+)
+def test_rendered_coast_over_most_of_the_horizon_does_not_tilt_the_line(tmp_path: Path):
+    """Rendered crossing, seed 0: the same within 2 px where the coast covers the horizon
+    from the left border over two-thirds of the width."""
+    for k, e0, e1 in _coast_clip_errors(tmp_path, seed=0):
+        assert e0 < 2.0 and e1 < 2.0, (k, e0, e1)
 
 
 # ----------------------------------------------------------------------------- no horizon

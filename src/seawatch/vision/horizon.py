@@ -76,6 +76,16 @@ the colour channels on the same scale. Then:
    half the bins (not one straight edge: e.g. a line through a hull on one side and
    the horizon on the other), a candidate with a better ``q · prior`` that crosses it
    inside the image and does hold half the bins replaces it.
+6b. **The straightest edge.** A refined line that holds under 60 % of the bins may join
+   two edges: the sky/sea edge on the open side and the top of a coast that sits on the
+   horizon on the other (the coast's own water line, the sea's true edge there, is a
+   weak edge of the other polarity and seldom a candidate). The line through the most
+   bin edge points within 0.5 px (every pair a quarter of the width apart tried, then a
+   least-squares fit to its points; at least a quarter of the points, spanning a quarter
+   of the width) replaces it when it moves an end by more than 2 px, keeps the tilt
+   limits, and has the higher region score (step 4): the straight sky/sea part, extended
+   across the coast. Where the coarse line meets the sky/sea edge only at one border the
+   horizon beyond lies outside the refinement's search window and is not recovered.
 
 The thresholds were chosen on synthetic scenes and checked on six real images, a
 real thermal clip and rendered footage (see the tests); the confidence is a score,
@@ -512,6 +522,11 @@ _FINE_SCALE = (1.0, 2.0)  # [full px] bounds of the Tukey cut-off of the final l
 _FINE_MIN_SUPPORT = 0.3  # least fraction of the bins on the fine line for it to be used
 _FINE_GOOD = 0.5  # a fine line with less support makes crossing candidates compete
 _SAME_LINE = 2.0  # [working px] candidates closer than this (mean |Δy|) are one line
+_STRAIGHT_BELOW = 0.6  # step 6b runs where the refined line holds fewer of the bins
+_STRAIGHT_TOL = 0.5  # [full px] an edge point within this of a line is on it (step 6b)
+_STRAIGHT_MIN = 0.25  # least fraction of the edge points on the straightest line
+_STRAIGHT_SPAN = 0.25  # least fraction of the width its points (and a hypothesis) span
+_STRAIGHT_MOVE = 2.0  # [full px] it replaces the refined line only if an end moves more
 _LUMA_BGR = np.array([0.114, 0.587, 0.299])  # ITU-R BT.601 weights (OpenCV's BGR2GRAY)
 _LUMA_GREY = np.array([1.0])
 _BGR2GREY = cv2.COLOR_BGR2GRAY
@@ -814,10 +829,10 @@ def _fine_fit(
     noise (or the median noise, if larger), and the robust line through them
     (:func:`_robust_line`, weights ``min(|D|, median |D|)``: a dark hull is no better
     evidence than the horizon), which may move the ends of the coarse line ``y0 + t x``
-    by at most ``dev`` [px]. Returns ``(n0, n1, support)``: the refined rows at the
+    by at most ``dev`` [px]. Returns ``(n0, n1, support, x, y)``: the refined rows at the
     first and last column [px] (NaN where there are too few bins or the fit moved
-    further) and the fraction of the bins with columns that lie within the fit's
-    cut-off."""
+    further), the fraction of the bins with columns that lie within the fit's cut-off,
+    and the bins' edge points (column, row) [px] that entered the fit."""
     nb = prof.shape[0]
     n_used = 0
     for b in range(nb):
@@ -831,7 +846,7 @@ def _fine_fit(
             wid[k] = width[b]
             k += 1
     if k < 4:
-        return np.nan, np.nan, 0.0
+        return np.nan, np.nan, 0.0, np.empty(0), np.empty(0)
     # transition half-window: 2.5 RMS widths of the edge, at least 2 px; levels over
     # max(3, g) rows beyond it
     g = min(max(math.ceil(2.5 * np.median(wid[:k]) + 0.5), 2), g_max)
@@ -842,7 +857,7 @@ def _fine_fit(
             wid[k] = noise[b]
             k += 1
     if k < 4:
-        return np.nan, np.nan, 0.0
+        return np.nan, np.nan, 0.0, np.empty(0), np.empty(0)
     noise_ref = np.median(wid[:k])
     xb = np.empty(nb)
     yb = np.empty(nb)
@@ -855,7 +870,7 @@ def _fine_fit(
             wb[n] = abs(D[b])
             n += 1
     if n < 4:
-        return np.nan, np.nan, 0.0
+        return np.nan, np.nan, 0.0, np.empty(0), np.empty(0)
     cap = np.median(wb[:n])
     for i in range(n):
         wb[i] = min(wb[i], cap)
@@ -865,9 +880,51 @@ def _fine_fit(
     support = inliers / max(n_used, 1)
     n0 = c - tt * xm
     n1 = c + tt * xm
+    xs, ys = xb[:n] + xm, yb[:n].copy()
     if max(abs(n0 - y0), abs(n1 - (y0 + 2.0 * t * xm))) > dev:
-        return np.nan, np.nan, support
-    return n0, n1, support
+        return np.nan, np.nan, support, xs, ys
+    return n0, n1, support, xs, ys
+
+
+@dataclass(frozen=True)
+class _Fine:
+    """Step 6's refined line: rows ``y0``, ``y1`` at the first and last column [px], the
+    fraction of the bins on it (``support``) and the bins' edge points ``x``, ``y`` [px]."""
+
+    y0: float
+    y1: float
+    support: float
+    x: np.ndarray
+    y: np.ndarray
+
+
+def _straightest(x: np.ndarray, y: np.ndarray, width: int) -> tuple[float, float] | None:
+    """Step 6b: the line through the most edge points ``(x, y)`` [px] within
+    :data:`_STRAIGHT_TOL` of it (every pair of points at least :data:`_STRAIGHT_SPAN` of
+    the ``width`` apart as a hypothesis, exhaustively: deterministic), refitted by least
+    squares to its points; its rows at the first and last column [px], or None when it
+    holds under :data:`_STRAIGHT_MIN` of the points or they span under
+    :data:`_STRAIGHT_SPAN` of the width.
+
+    Hand-written: a deterministic exhaustive RANSAC over at most 160 bins (12,720 pairs,
+    one vectorised residual matrix); OpenCV's and scikit-image's RANSAC are randomised."""
+    n = x.size
+    if n < 4:
+        return None
+    i, j = np.triu_indices(n, 1)
+    far = np.abs(x[j] - x[i]) >= _STRAIGHT_SPAN * width
+    i, j = i[far], j[far]
+    if i.size == 0:
+        return None
+    t = (y[j] - y[i]) / (x[j] - x[i])
+    c = y[i] - t * x[i]
+    count = (np.abs(y[None, :] - (c[:, None] + t[:, None] * x[None, :])) <= _STRAIGHT_TOL).sum(1)
+    k = int(np.argmax(count))
+    on = np.abs(y - (c[k] + t[k] * x)) <= _STRAIGHT_TOL
+    if on.sum() < _STRAIGHT_MIN * n or np.ptp(x[on]) < _STRAIGHT_SPAN * width:
+        return None
+    tt, cc = np.polyfit(x[on], y[on], 1)
+    return float(cc), float(cc + tt * (width - 1))
 
 
 def _fine_line(
@@ -878,10 +935,11 @@ def _fine_line(
     sx: float,
     sy: float,
     cw: tuple[float, float, float],
-) -> tuple[float, float, float] | None:
+) -> _Fine | None:
     """Step 6: the coarse line (y0, y1) [full px] refined on the full-resolution image
-    ``arr``: ``(y0, y1, support)``, or None (too few bins with an edge near it, too
-    little support, or a correction beyond two working rows: keep the coarse line).
+    ``arr``: a :class:`_Fine` (the line, its support, the bins' edge points), or None
+    (too few bins with an edge near it, too little support, or a correction beyond two
+    working rows: keep the coarse line).
 
     ``P``, ``sx``, ``sy``, ``cw`` are the working image's strip-mean gradients, its
     reduction factors (full px per working px) and the coarse line in working
@@ -910,12 +968,12 @@ def _fine_line(
     pol = _strip_polarity(P, xbar, sx, cw[2], cw[0], cw[1])
     dev = 2.0 * sy + 1.0  # largest correction at the ends: two working rows [px]
     s_max = max(_FINE_SCALE[1], 0.25 * sy)
-    n0, n1, support = _fine_fit(
+    n0, n1, support, ex, ey = _fine_fit(
         prof, rbar + y_top, xbar, cnt, pol, R, S, g_max, y0, t, 0.5 * (W - 1), s_max, dev
     )
     if not (math.isfinite(n0) and support >= _FINE_MIN_SUPPORT):
         return None
-    return float(n0), float(n1), float(support)
+    return _Fine(float(n0), float(n1), float(support), ex, ey)
 
 
 def _local_maxima(E: np.ndarray, count: int, rad_t: int, rad_c: int) -> list[tuple[int, int]]:
@@ -1138,11 +1196,11 @@ def detect_horizon(
 
     # 6. sub-pixel refinement on the full-resolution image; a line that does not hold
     # as one straight edge at full resolution gives way to a candidate crossing it
-    def refine(cd: _Candidate) -> tuple[float, float, float] | None:
+    def refine(cd: _Candidate) -> _Fine | None:
         return _fine_line(arr, *to_full(cd.c, cd.t), P, sx, sy, (cd.c, cd.t, sw))
 
     chosen, fine = best, refine(best)
-    if fine is None or fine[2] < _FINE_GOOD:
+    if fine is None or fine.support < _FINE_GOOD:
         # not one straight edge at full resolution: another fit of the same edge that
         # crosses the chosen line inside the image (e.g. through a hull on one side and
         # the horizon on the other) and holds as one straight edge replaces it
@@ -1158,11 +1216,27 @@ def detect_horizon(
         ]
         for cd in sorted(crossing, key=lambda cd: -cd.quality * cd.prior):
             alt = refine(cd)
-            if alt is not None and alt[2] >= _FINE_GOOD:
+            if alt is not None and alt.support >= _FINE_GOOD:
                 chosen, fine = cd, alt
                 break
-    y0, y1 = to_full(chosen.c, chosen.t) if fine is None else fine[:2]
-    region = 1.0 - math.exp(-chosen.region / _REGION_SCALE)
+    y0, y1 = to_full(chosen.c, chosen.t) if fine is None else (fine.y0, fine.y1)
+    region_score = chosen.region
+    # 6b. a line that holds few of the bins may join two edges (the sky/sea edge on the
+    # open side and the top of a coast on the other): the straightest edge among the
+    # bins replaces it where it is the better sea horizon by the region test
+    if fine is not None and fine.support < _STRAIGHT_BELOW:
+        alt_ends = _straightest(fine.x, fine.y, W)
+        if (
+            alt_ends is not None
+            and max(abs(alt_ends[0] - y0), abs(alt_ends[1] - y1)) > _STRAIGHT_MOVE
+        ):
+            yw = (np.array(alt_ends) + 0.5) / sy - 0.5  # working rows at the border columns
+            t_a = float((yw[1] - yw[0]) / (xw_ends[1] - xw_ends[0]))
+            c_a = float(yw[0] + t_a * (xc - xw_ends[0]))
+            r_a = float(_region(cum, c_a, t_a, xs, xc, band, 2))
+            if lo_t <= t_a <= hi_t and 0.0 <= c_a < h and r_a > region_score:
+                (y0, y1), region_score = alt_ends, r_a
+    region = 1.0 - math.exp(-region_score / _REGION_SCALE)
     conf = float(np.clip(math.sqrt(chosen.quality * chosen.prior * region), 0.0, 1.0))
     found = conf >= min_confidence and conf > 0.0
     return HorizonEstimate.from_endpoints(y0, y1, W, H, found=found, confidence=conf)
