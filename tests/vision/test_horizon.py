@@ -341,6 +341,16 @@ def test_rendered_coast_on_part_of_the_horizon_does_not_tilt_the_line(tmp_path: 
         assert e0 < 0.5 and e1 < 0.5, (k, e0, e1)
 
 
+def test_rendered_coast_from_the_left_border_keeps_the_open_sea_end(tmp_path: Path):
+    """Rendered crossing, seed 0 (the coast from the left border over two-thirds of the
+    width): the line's right end, on the open sky/sea edge, stays within 2.5 px of the
+    horizon in every frame (measured 1.9–2.2 px). Step 6b may not swap the line for a
+    straight stretch of the coast's top that runs above it there (which took the right
+    end 8–12 px up before its "nowhere above" condition)."""
+    for k, _, e1 in _coast_clip_errors(tmp_path, seed=0):
+        assert e1 < 2.5, (k, e1)
+
+
 @pytest.mark.xfail(
     strict=True,
     reason="known failure (issue 6): rendered crossing, seed 0: the coarse line follows "

@@ -82,9 +82,10 @@ the colour channels on the same scale. Then:
    weak edge of the other polarity and seldom a candidate). The line through the most
    bin edge points within 0.5 px (every pair a quarter of the width apart tried, then a
    least-squares fit to its points; at least a quarter of the points, spanning a quarter
-   of the width) replaces it when it moves an end by more than 2 px, keeps the tilt
-   limits, and has the higher region score (step 4): the straight sky/sea part, extended
-   across the coast. Where the coarse line meets the sky/sea edge only at one border the
+   of the width) replaces it when it moves an end down by more than 2 px and neither up
+   by more (a coast on the horizon lies above the sea's edge, never below it), keeps the
+   tilt limits, and has the higher region score (step 4): the straight sky/sea part,
+   extended across the coast. Where the coarse line meets the sky/sea edge only at one border the
    horizon beyond lies outside the refinement's search window and is not recovered.
 
 The thresholds were chosen on synthetic scenes and checked on six real images, a
@@ -1223,12 +1224,14 @@ def detect_horizon(
     region_score = chosen.region
     # 6b. a line that holds few of the bins may join two edges (the sky/sea edge on the
     # open side and the top of a coast on the other): the straightest edge among the
-    # bins replaces it where it is the better sea horizon by the region test
+    # bins replaces it where it lies nowhere above it (the sea's edge is the lowest) and
+    # is the better sea horizon by the region test
     if fine is not None and fine.support < _STRAIGHT_BELOW:
         alt_ends = _straightest(fine.x, fine.y, W)
         if (
             alt_ends is not None
             and max(abs(alt_ends[0] - y0), abs(alt_ends[1] - y1)) > _STRAIGHT_MOVE
+            and min(alt_ends[0] - y0, alt_ends[1] - y1) >= -_STRAIGHT_MOVE
         ):
             yw = (np.array(alt_ends) + 0.5) / sy - 0.5  # working rows at the border columns
             t_a = float((yw[1] - yw[0]) / (xw_ends[1] - xw_ends[0]))
