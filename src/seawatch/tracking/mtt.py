@@ -499,10 +499,10 @@ class MultiTargetTracker:
         valid = np.flatnonzero(np.all(np.isfinite(centres), axis=1))
         if sizes is not None:
             valid = valid[np.all(np.isfinite(sizes[valid]), axis=1)]
+        z = centres[valid]
 
         # 1. predict
         self._predict(dt)
-        z = centres[valid]
         # 2.–3. gate and assign
         boxes = sizes is not None and self.overlap_gate is not None
         zs = None if sizes is None else sizes[valid]

@@ -85,8 +85,9 @@ the colour channels on the same scale. Then:
    of the width) replaces it when it moves an end down by more than 2 px and neither up
    by more (a coast on the horizon lies above the sea's edge, never below it), keeps the
    tilt limits, and has the higher region score (step 4): the straight sky/sea part,
-   extended across the coast. Where the coarse line meets the sky/sea edge only at one border the
-   horizon beyond lies outside the refinement's search window and is not recovered.
+   extended across the coast. Where the coarse line meets the sky/sea edge only near one
+   border, the horizon beyond lies outside the refinement's search window and is not
+   recovered.
 
 The thresholds were chosen on synthetic scenes and checked on six real images, a
 real thermal clip and rendered footage (see the tests); the confidence is a score,
