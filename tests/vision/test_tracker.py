@@ -222,7 +222,7 @@ def test_fvessel_real_detections_keep_every_ship_with_few_ids():
     frame/s, tracked with VisualTracker's defaults and scored by TrackEval (IoU >= 0.5)
     against the ground truth (docs/results/fvessel/). Measured (session 12, with the
     size-relative box noise sigma_z_rel = 3 %): HOTA 0.672, MOTA 0.847, IDF1 0.907, 1 ID
-    switch, 7 track ids (session 11, σ_z alone: 0.594, 0.802, 0.773, 3, 11; the authors'
+    switch, 6 track ids (session 11, σ_z alone: 0.594, 0.802, 0.773, 3, 11; the authors'
     tracker: 0.652, 0.867, 0.847, 2, 9). The bounds are those numbers with a margin, a
     regression guard on real data, and every ship must be covered by a track for most
     of its frames."""
