@@ -1109,6 +1109,12 @@ def detect_horizon(
         yf = (c + t * (xw_ends - xc) + 0.5) * sy - 0.5
         return float(yf[0]), float(yf[1])
 
+    def to_work(y0: float, y1: float) -> tuple[float, float]:
+        """Full-resolution rows y0, y1 at the border columns → working (c, t)."""
+        yw = (np.array([y0, y1]) + 0.5) / sy - 0.5
+        t = float((yw[1] - yw[0]) / (xw_ends[1] - xw_ends[0]))
+        return float(yw[0] + t * (xc - xw_ends[0])), t
+
     def result(c: float, t: float, conf: float) -> HorizonEstimate:
         conf = float(np.clip(conf, 0.0, 1.0))
         y0, y1 = to_full(c, t)
@@ -1125,9 +1131,9 @@ def detect_horizon(
     for est in (previous, nominal):
         if est is None or not est.found:
             continue
-        yw = ((np.array([est.y0, est.y1]) + 0.5) * (H / est.height)) / sy - 0.5
-        t_p = float((yw[1] - yw[0]) / (xw_ends[1] - xw_ends[0]))
-        priors.append((float(yw[0] + t_p * (xc - xw_ends[0])), t_p))
+        scale = H / est.height  # a line found at another resolution
+        c_p, t_p = to_work((est.y0 + 0.5) * scale - 0.5, (est.y1 + 0.5) * scale - 0.5)
+        priors.append((c_p, t_p))
         if est is nominal:
             tilt_centre = math.atan(t_p)
 
@@ -1234,9 +1240,7 @@ def detect_horizon(
             and max(abs(alt_ends[0] - y0), abs(alt_ends[1] - y1)) > _STRAIGHT_MOVE
             and min(alt_ends[0] - y0, alt_ends[1] - y1) >= -_STRAIGHT_MOVE
         ):
-            yw = (np.array(alt_ends) + 0.5) / sy - 0.5  # working rows at the border columns
-            t_a = float((yw[1] - yw[0]) / (xw_ends[1] - xw_ends[0]))
-            c_a = float(yw[0] + t_a * (xc - xw_ends[0]))
+            c_a, t_a = to_work(*alt_ends)
             r_a = float(_region(cum, c_a, t_a, xs, xc, band, 2))
             if lo_t <= t_a <= hi_t and 0.0 <= c_a < h and r_a > region_score:
                 (y0, y1), region_score = alt_ends, r_a
