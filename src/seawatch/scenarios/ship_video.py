@@ -324,6 +324,24 @@ def merge(
     return _result(done, names, runs, seed, outputs)
 
 
+def _tables(
+    done: Sequence[dict[str, Any]],
+) -> tuple[dict[tuple[str, str, str], list[float]], dict[float, list[float]]]:
+    """The units' numbers: ``(estimator, metric, case) → values over the renderings`` for
+    cle_px, cle_percent and cle_precision, and ``order → cle_percent values`` of the
+    sweep."""
+    values: dict[tuple[str, str, str], list[float]] = {}
+    sweep: dict[float, list[float]] = {}
+    for unit in done:
+        for est, a, px, pct, prec in unit["rows"]:
+            if a is None:
+                for metric, v in (("cle_px", px), ("cle_percent", pct), ("cle_precision", prec)):
+                    values.setdefault((est, metric, unit["case"]), []).append(v)
+            else:
+                sweep.setdefault(a, []).append(pct)
+    return values, sweep
+
+
 def plot_cle(done: Sequence[dict[str, Any]], path: str | Path) -> Path:
     """The experiment's figures in one PNG: (a) the centre location error [% of the truth
     box diagonal] per case for the adaptive fractional, fractional and integer-order KF
@@ -335,14 +353,7 @@ def plot_cle(done: Sequence[dict[str, Any]], path: str | Path) -> Path:
     from matplotlib.figure import Figure
 
     cases = list(dict.fromkeys(u["case"] for u in done))
-    per: dict[tuple[str, str], list[float]] = {}
-    sweep: dict[float, list[float]] = {}
-    for unit in done:
-        for est, a, _px, pct, _prec in unit["rows"]:
-            if a is None:
-                per.setdefault((unit["case"], est), []).append(pct)
-            else:
-                sweep.setdefault(float(a), []).append(pct)
+    values, sweep = _tables(done)
     fig = Figure(figsize=(11.0, 4.2), dpi=110)
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(1, 2, 1)
@@ -350,7 +361,7 @@ def plot_cle(done: Sequence[dict[str, Any]], path: str | Path) -> Path:
     width = 0.27
     for k, est in enumerate(FILTERS):
         x = np.arange(len(cases)) + (k - 1) * width
-        vals = [np.asarray(per.get((c, est), [np.nan]), dtype=float) for c in cases]
+        vals = [np.asarray(values.get((est, "cle_percent", c), [np.nan])) for c in cases]
         ax.bar(x, [np.nanmean(v) for v in vals], width, color=colours[est], label=est)
         for xi, v in zip(x, vals, strict=True):
             if v.size > 1:
@@ -386,15 +397,7 @@ def plot_cle(done: Sequence[dict[str, Any]], path: str | Path) -> Path:
 def _result(
     done: list[dict[str, Any]], names: list[str], runs: int, seed: int, outputs: list[Path]
 ) -> ExperimentResult:
-    values: dict[tuple[str, str, str], list[float]] = {}
-    sweep: dict[float, list[float]] = {}
-    for unit in done:
-        for est, a, px, pct, prec in unit["rows"]:
-            if a is None:
-                for metric, v in (("cle_px", px), ("cle_percent", pct), ("cle_precision", prec)):
-                    values.setdefault((est, metric, unit["case"]), []).append(v)
-            else:
-                sweep.setdefault(a, []).append(pct)
+    values, sweep = _tables(done)
     units = {"cle_px": "px", "cle_percent": "%", "cle_precision": "%"}
     results = [
         record(est, metric, units[metric], v, params={"case": name})
