@@ -430,6 +430,7 @@ class MultiTargetTracker:
         self._next_id = 1
         self._time: float | None = None
         self._anchored: tuple[NDArray[np.int64], FloatArray, NDArray[np.bool_]] | None = None
+        self._S: FloatArray | None = None
         self._boxes: bool | None = None
 
     @property
@@ -508,6 +509,7 @@ class MultiTargetTracker:
         zs = None if sizes is None else sizes[valid]
         edges = None  # tracks measured by the free edges of their boxes
         self._anchored = None  # the gate's anchored centres of this scan (_anchor_pairs)
+        self._S = None  # the predicted tracks' innovation covariances, once computed
         if zs is not None and self.occlusion and np.count_nonzero(self._confirmed) >= 2:
             edges = self._confirmed.copy()
         if self.confirmed_first:
@@ -527,6 +529,7 @@ class MultiTargetTracker:
             anchored[rows[~grow.all(axis=1)]] = True
         assigned = np.zeros(self.n_tracks, bool)
         assigned[rows] = True
+        self._S = None  # the update changes P
         self._update(rows, zu)
         detection = np.full(self.n_tracks, -1, np.int64)
         detection[rows] = valid[cols]
@@ -629,8 +632,13 @@ class MultiTargetTracker:
         return R
 
     def _innovation_covariance(self) -> FloatArray:
-        S = self.H @ self._P @ self.H.T + self._noise()
-        return 0.5 * (S + np.swapaxes(S, 1, 2))
+        """``S_i = H P_i Hᵀ + R_i`` (T, 2, 2) of the predicted tracks, computed once per
+        scan: the gate (:meth:`_associate`, once per cascade group) and the occlusion
+        stage share it."""
+        if self._S is None:
+            S = self.H @ self._P @ self.H.T + self._noise()
+            self._S = 0.5 * (S + np.swapaxes(S, 1, 2))
+        return self._S
 
     def _cascade(
         self,
