@@ -191,8 +191,7 @@ def render_clip(
     """
     frames = integer("frames", frames, 2)
     for name, value in (("width", width), ("height", height)):
-        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 64:
-            raise ValueError(f"{name}: expected an integer >= 64 px, got {value!r}")
+        integer(name, value, 64)  # [px]
     if not (isinstance(fps, int | float) and math.isfinite(fps) and fps > 0):
         raise ValueError(f"fps: expected a positive frame rate, got {fps!r}")
     out = Path(folder) if folder is not None else _default_folder(frames, width, height, fps, seed)

@@ -609,8 +609,8 @@ class Renderer:
             return level, False
         attitudes = [(cam.heading, cam.pitch, cam.roll)]
         ra, pa = (self.sway[0], self.sway[1]) if self.sway is not None else (0.0, 0.0)
-        ya = self.pan[0] if self.pan is not None else 0.0
-        for dy in (-ya, 0.0, ya):
+        yaws = (0.0,) if self.pan is None else (-self.pan[0], 0.0, self.pan[0])
+        for dy in yaws:
             for dr in (-ra, ra):
                 for dp in (-pa, pa):
                     attitudes.append((cam.heading + dy, cam.pitch + dp, cam.roll + dr))
