@@ -329,7 +329,20 @@ def _coast_clip_errors(tmp_path: Path, seed: int) -> list[tuple[int, float, floa
     return out
 
 
-def test_rendered_coast_on_part_of_the_horizon_does_not_tilt_the_line(tmp_path: Path):
+@pytest.fixture(scope="module")
+def coast_errors(tmp_path_factory):
+    """:func:`_coast_clip_errors` by seed, each clip rendered once for the module."""
+    cache: dict[int, list[tuple[int, float, float]]] = {}
+
+    def errors(seed: int) -> list[tuple[int, float, float]]:
+        if seed not in cache:
+            cache[seed] = _coast_clip_errors(tmp_path_factory.mktemp(f"coast{seed}"), seed)
+        return cache[seed]
+
+    return errors
+
+
+def test_rendered_coast_on_part_of_the_horizon_does_not_tilt_the_line(coast_errors):
     """Rendered crossing, seed 1: a coastline sits on the horizon over the right
     two-thirds of the width, open sky over the sea on the left. The sea horizon is the
     sky/sea edge on the left and the land's water line on the right, one straight line.
@@ -337,17 +350,17 @@ def test_rendered_coast_on_part_of_the_horizon_does_not_tilt_the_line(tmp_path: 
     high, its refined fit holding under half the bins); step 6b's straightest edge among
     the bins (the sky/sea part) is the better sea horizon by the region test and replaces
     it: both ends within 0.5 px in every frame (measured 0.04–0.4 px)."""
-    for k, e0, e1 in _coast_clip_errors(tmp_path, seed=1):
+    for k, e0, e1 in coast_errors(1):
         assert e0 < 0.5 and e1 < 0.5, (k, e0, e1)
 
 
-def test_rendered_coast_from_the_left_border_keeps_the_open_sea_end(tmp_path: Path):
+def test_rendered_coast_from_the_left_border_keeps_the_open_sea_end(coast_errors):
     """Rendered crossing, seed 0 (the coast from the left border over two-thirds of the
     width): the line's right end, on the open sky/sea edge, stays within 2.5 px of the
     horizon in every frame (measured 1.9–2.2 px). Step 6b may not swap the line for a
     straight stretch of the coast's top that runs above it there (which took the right
     end 8–12 px up before its "nowhere above" condition)."""
-    for k, _, e1 in _coast_clip_errors(tmp_path, seed=0):
+    for k, _, e1 in coast_errors(0):
         assert e1 < 2.5, (k, e1)
 
 
@@ -358,10 +371,10 @@ def test_rendered_coast_from_the_left_border_keeps_the_open_sea_end(tmp_path: Pa
     "right end, so the sea horizon on the left lies outside the refinement's search "
     "window (left end 28-29 px high in 192 of 200 frames)",
 )
-def test_rendered_coast_over_most_of_the_horizon_does_not_tilt_the_line(tmp_path: Path):
+def test_rendered_coast_over_most_of_the_horizon_does_not_tilt_the_line(coast_errors):
     """Rendered crossing, seed 0: the same within 2 px where the coast covers the horizon
     from the left border over two-thirds of the width."""
-    for k, e0, e1 in _coast_clip_errors(tmp_path, seed=0):
+    for k, e0, e1 in coast_errors(0):
         assert e0 < 2.0 and e1 < 2.0, (k, e0, e1)
 
 
