@@ -139,6 +139,15 @@ def test_no_horizon_searches_the_sky_too(tmp_path):
     assert any(b["v_wl"] < HORIZON for b in everywhere)
 
 
+@pytest.mark.parametrize(("polarity", "kept"), [("both", [0, 1]), ("dark", [0]), ("bright", [1])])
+def test_polarity_keeps_the_dark_hull_or_the_bright_boat(tmp_path, polarity, kept):
+    folder, truths = _folder(tmp_path, n=2)
+    res = runner.invoke(app, [str(folder), "--json", "--polarity", polarity])
+    assert res.exit_code == 0, res.output
+    for f, truth in zip(json.loads(res.stdout)["frames"], truths, strict=True):
+        assert _matches(f["boxes"], truth[kept]), (polarity, f["boxes"])
+
+
 def test_human_readable_output_has_one_line_per_frame(tmp_path):
     folder, _ = _folder(tmp_path, n=2)
     res = runner.invoke(app, [str(folder)])
@@ -177,6 +186,8 @@ def test_bad_inputs_exit_2_naming_the_input(tmp_path):
     folder, _ = _folder(tmp_path, n=1)
     res = runner.invoke(app, [str(folder), "--model", str(tmp_path / "m.onnx")])
     assert res.exit_code == 2 and "--model" in _msg(res)
+    res = runner.invoke(app, [str(folder), "--polarity", "grey"])
+    assert res.exit_code == 2 and "--polarity" in _msg(res)
     res = runner.invoke(app, [str(folder), "--start", "2", "--end", "1"])
     assert res.exit_code == 2 and "--end" in _msg(res)
     garbage = tmp_path / "garbage.mp4"

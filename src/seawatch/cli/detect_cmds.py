@@ -41,12 +41,84 @@ from seawatch.cli._common import (
     warnings_to_stderr,
 )
 
-__all__ = ["CSV_COLUMNS", "detect"]
+__all__ = [
+    "CSV_COLUMNS",
+    "ModelOption",
+    "PolarityOption",
+    "TemporalOption",
+    "ThresholdOption",
+    "build_detector",
+    "detect",
+]
 
 CSV_COLUMNS = ("index", "file", "time", "x", "y", "w", "h", "score", "u_wl", "v_wl")
 """Columns of ``-o BOXES.csv`` (INTERFACES.md), one row per box."""
 
 _BOX_KEYS = ("x", "y", "w", "h", "score", "u_wl", "v_wl")
+
+# the detector's options, shared by `seawatch detect` and `seawatch track`
+ModelOption = Annotated[
+    Path | None,
+    typer.Option(
+        "--model",
+        help="A YOLO-style ONNX model to use instead of the classical detector "
+        "(needs onnxruntime).",
+    ),
+]
+ThresholdOption = Annotated[
+    float | None,
+    typer.Option(
+        help="Detection threshold: noise units for the classical detector (default 6), "
+        "a score in [0, 1] for --model (default 0.25).",
+        min=0.0,
+    ),
+]
+PolarityOption = Annotated[
+    str,
+    typer.Option(
+        help="Ships the classical detector looks for: both, dark (darker than the sea: "
+        "looking into the sun, where every hull is a silhouette and the bright boxes are "
+        "sun glitter) or bright (a thermal camera's warm hulls).",
+    ),
+]
+TemporalOption = Annotated[
+    bool,
+    typer.Option(
+        "--temporal/--no-temporal",
+        help="Temporal clutter model across frames (suppresses flicker and static "
+        "clutter in video; off by default).",
+    ),
+]
+
+
+def build_detector(
+    model: Path | None, threshold: float | None, polarity: str = "both", temporal: bool = False
+) -> Any:
+    """The ship detector of the detector options: an ONNX model (``--model``) or the
+    classical detector; :class:`BadInput` naming the option for a bad value."""
+    from seawatch.vision.detect import ClassicalShipDetector
+    from seawatch.vision.external import OnnxDetector
+
+    if polarity not in ("both", "dark", "bright"):
+        raise BadInput(f"--polarity: expected both, dark or bright, got {polarity!r}")
+    if model is not None:
+        if not model.is_file():
+            raise BadInput(f"--model {model}: no such ONNX model file")
+        if threshold is not None and threshold > 1:
+            raise BadInput(f"--threshold: a model score in [0, 1], got {threshold}")
+        try:
+            return OnnxDetector(model, score_threshold=0.25 if threshold is None else threshold)
+        except ImportError as exc:
+            raise BadInput(f"--model {model}: {exc}") from None
+    thr = 6.0 if threshold is None else threshold
+    if not thr > 0:
+        raise BadInput(f"--threshold: expected a number of noise units > 0, got {thr}")
+    return ClassicalShipDetector(
+        threshold=thr,
+        grow_threshold=min(3.0, thr),
+        temporal=temporal,
+        polarity=polarity,  # type: ignore[arg-type]
+    )
 
 
 def _record(frame: Any, boxes: Any) -> dict[str, Any]:
@@ -84,22 +156,9 @@ def detect(
         Path | None,
         typer.Option("--output", "-o", help="BOXES.csv, one row per box, written frame by frame."),
     ] = None,
-    model: Annotated[
-        Path | None,
-        typer.Option(
-            "--model",
-            help="A YOLO-style ONNX model to use instead of the classical detector "
-            "(needs onnxruntime).",
-        ),
-    ] = None,
-    threshold: Annotated[
-        float | None,
-        typer.Option(
-            help="Detection threshold: noise units for the classical detector (default 6), "
-            "a score in [0, 1] for --model (default 0.25).",
-            min=0.0,
-        ),
-    ] = None,
+    model: ModelOption = None,
+    threshold: ThresholdOption = None,
+    polarity: PolarityOption = "both",
     use_horizon: Annotated[
         bool,
         typer.Option(
@@ -108,14 +167,7 @@ def detect(
             "whole frame.",
         ),
     ] = True,
-    temporal: Annotated[
-        bool,
-        typer.Option(
-            "--temporal/--no-temporal",
-            help="Temporal clutter model across frames (suppresses flicker and static "
-            "clutter in video; off by default).",
-        ),
-    ] = False,
+    temporal: TemporalOption = False,
     step: Annotated[int, typer.Option(help="Use every STEP-th frame.", min=1)] = 1,
     fps: Annotated[
         float | None,
@@ -139,30 +191,11 @@ def detect(
     Example: [cyan]seawatch detect clip.mp4 --json -o boxes.csv[/]
     """
     from seawatch.io.video import VideoReader
-    from seawatch.vision.detect import ClassicalShipDetector
-    from seawatch.vision.external import OnnxDetector
 
     with exit_codes(), warnings_to_stderr():
         if end is not None and end <= start:
             raise BadInput(f"--end: must be after --start ({start} s), got {end} s")
-        if model is not None:
-            if not model.is_file():
-                raise BadInput(f"--model {model}: no such ONNX model file")
-            if threshold is not None and threshold > 1:
-                raise BadInput(f"--threshold: a model score in [0, 1], got {threshold}")
-            try:
-                detector: Any = OnnxDetector(
-                    model, score_threshold=0.25 if threshold is None else threshold
-                )
-            except ImportError as exc:
-                raise BadInput(f"--model {model}: {exc}") from None
-        else:
-            thr = 6.0 if threshold is None else threshold
-            if not thr > 0:
-                raise BadInput(f"--threshold: expected a number of noise units > 0, got {thr}")
-            detector = ClassicalShipDetector(
-                threshold=thr, grow_threshold=min(3.0, thr), temporal=temporal
-            )
+        detector = build_detector(model, threshold, polarity, temporal)
         reader = VideoReader(
             source, step=step, start=start, end=end, max_frames=max_frames, fps=fps
         )

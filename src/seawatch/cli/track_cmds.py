@@ -19,6 +19,13 @@ from seawatch.cli._common import (
     progress_bar,
     warnings_to_stderr,
 )
+from seawatch.cli.detect_cmds import (
+    ModelOption,
+    PolarityOption,
+    TemporalOption,
+    ThresholdOption,
+    build_detector,
+)
 
 
 @contextmanager
@@ -120,6 +127,10 @@ def track(
         ),
     ] = "auto",
     filter: Annotated[str, typer.Option(help="Visual tracking filter: afkf, fkf or kf.")] = "afkf",
+    model: ModelOption = None,
+    threshold: ThresholdOption = None,
+    polarity: PolarityOption = "both",
+    temporal: TemporalOption = False,
     pixel_sigma: Annotated[
         float, typer.Option(help="1-sigma of the water-line pixel [px].", min=0.01)
     ] = 1.0,
@@ -156,6 +167,7 @@ def track(
         if filter not in ("afkf", "fkf", "kf"):
             raise BadInput(f"--filter: expected afkf, fkf or kf, got {filter!r}")
         check_options(estimator, attitude)
+        detector = build_detector(model, threshold, polarity, temporal)
         inputs = _load_inputs(camera, platform, ais, truth, start)
         live = "://" in source or source.isdigit() or source.startswith("/dev/")
         with progress_bar() as bar, _terminate_as_interrupt():
@@ -176,6 +188,7 @@ def track(
                 truth=truth,
                 start=inputs["start"],
                 filter=filter,
+                detector=detector,
                 estimator=estimator,
                 attitude=attitude,  # type: ignore[arg-type]
                 sigma_px=pixel_sigma,
