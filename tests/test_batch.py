@@ -68,3 +68,19 @@ def test_bad_batch_inputs_exit_2(clips, tmp_path):
     assert res.exit_code == 2 and "none.yaml" in res.output
     res = runner.invoke(app, ["batch", video, "--estimator", "magic"])
     assert res.exit_code == 2 and "--estimator" in res.output
+    res = runner.invoke(app, ["batch", video, "--polarity", "grey", "--out", str(tmp_path / "p")])
+    assert res.exit_code == 2 and "--polarity" in res.output
+    assert not (tmp_path / "p").exists()  # before any work
+
+
+def test_detector_options_reach_each_recordings_detector(clips, tmp_path):
+    """With a detection threshold of 500 noise units the recording has no track rows; with
+    the default (6) its ship is tracked: the options reach the worker's detector."""
+    sources = [str(clips / "a" / "video.mp4")]
+    rows = {}
+    for threshold in (None, 500.0):
+        res = track_batch(sources, tmp_path / str(threshold), workers=1, annotate=False,
+                          report=False, detector_options={"threshold": threshold})  # fmt: skip
+        assert res.items[0].ok
+        rows[threshold] = res.items[0].summary["rows"]
+    assert rows[None] > 5 and rows[500.0] == 0

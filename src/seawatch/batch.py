@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -77,18 +77,28 @@ def _folder_names(sources: Sequence[str]) -> list[str]:
     return names
 
 
-def _track_one(source: str, out_dir: str, camera: str | None, options: dict[str, Any]) -> Any:
-    """The task of one recording (runs on a worker): a summary dict or an error string."""
+def _track_one(
+    source: str,
+    out_dir: str,
+    camera: str | None,
+    options: dict[str, Any],
+    detector_options: dict[str, Any],
+) -> Any:
+    """The task of one recording (runs on a worker): a summary dict or an error string.
+    Each recording gets its own detector (one keeps work buffers and, with the temporal
+    model, the recording's clutter)."""
     import warnings
 
     from seawatch.io.camera_file import load_camera
     from seawatch.pipeline import track_video
+    from seawatch.vision.external import make_detector
 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # they are in the summary's "warnings"
             cam = load_camera(camera) if camera is not None else None
-            run = track_video(source, out_dir, camera=cam, **options)
+            detector = make_detector(**detector_options)
+            run = track_video(source, out_dir, camera=cam, detector=detector, **options)
         return run.to_json()
     except Exception as exc:  # reported per recording; the others go on
         return f"{type(exc).__name__}: {exc}"
@@ -102,6 +112,7 @@ def track_batch(
     workers: int | None = None,
     scheduler: Any = None,
     progress: Callable[[int, int], None] | None = None,
+    detector_options: Mapping[str, Any] | None = None,
     **options: Any,
 ) -> BatchResult:
     """Track every recording of ``sources`` into ``out_dir/<name>/`` (module docstring).
@@ -114,19 +125,26 @@ def track_batch(
             recordings one after the other in this process, without Dask.
         scheduler: address of an existing Dask scheduler (``tcp://HOST:8786``).
         progress: ``progress(done, total)`` after each recording.
+        detector_options: keywords of :func:`seawatch.vision.external.make_detector`
+            (``model``, ``threshold``, ``polarity``, ``temporal``); each recording gets a
+            detector of its own. None: the classical detector's defaults.
         options: further :func:`seawatch.pipeline.track_video` keywords (``estimator``,
             ``attitude``, ``annotate``, ``report``, …; files such as ``truth`` do not
             apply to a whole batch).
 
     Raises:
-        ValueError: no source, an unwritable ``out_dir`` or a missing camera file (before
-            any work); SchedulerError (a ValueError) when the scheduler does not answer.
+        ValueError: no source, an unwritable ``out_dir``, a missing camera file or bad
+            detector options (before any work); SchedulerError (a ValueError) when the
+            scheduler does not answer.
     """
     from seawatch.report.geojson import atomic_write_text
+    from seawatch.vision.external import make_detector
 
     srcs = [str(s) for s in sources]
     if not srcs:
         raise ValueError("SOURCES: expected at least one video, folder or stream")
+    det_opts = dict(detector_options or {})
+    make_detector(**det_opts)  # bad options fail here, before any work
     if camera is not None and not Path(camera).is_file():
         raise ValueError(f"--camera {camera}: no such file")
     out = Path(out_dir)
@@ -149,7 +167,7 @@ def track_batch(
 
     if workers == 1 and scheduler is None:
         for i, (src, folder) in enumerate(zip(srcs, folders, strict=True)):
-            record(i, _track_one(src, folder, cam, options), i + 1)
+            record(i, _track_one(src, folder, cam, options, det_opts), i + 1)
     else:
         from distributed import as_completed
 
@@ -157,7 +175,7 @@ def track_batch(
 
         with dask_client(workers, scheduler) as client:
             futures = [
-                client.submit(_track_one, src, folder, cam, options, pure=False)
+                client.submit(_track_one, src, folder, cam, options, det_opts, pure=False)
                 for src, folder in zip(srcs, folders, strict=True)
             ]
             index = {f.key: i for i, f in enumerate(futures)}

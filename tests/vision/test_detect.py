@@ -31,7 +31,7 @@ from seawatch.vision.detect import (
     sea_region,
     waterline_points,
 )
-from seawatch.vision.external import CallableDetector, OnnxDetector, decode_yolo
+from seawatch.vision.external import CallableDetector, OnnxDetector, decode_yolo, make_detector
 
 MARDCT = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "mardct_ir3"
 needs_mardct = pytest.mark.skipif(
@@ -893,6 +893,26 @@ def test_onnx_detector_needs_an_existing_model_and_says_how_to_get_onnxruntime(
     monkeypatch.setitem(sys.modules, "onnxruntime", None)  # as if not installed
     with pytest.raises(ImportError, match="pip install onnxruntime"):
         OnnxDetector(model)
+
+
+def test_make_detector_builds_the_options_detector_or_names_the_bad_option(tmp_path, monkeypatch):
+    det = make_detector(threshold=8.0, polarity="dark", temporal=True)
+    assert isinstance(det, ClassicalShipDetector)
+    assert (det.threshold, det.grow_threshold, det.polarity, det.temporal) == (8, 3, "dark", True)
+    assert make_detector(threshold=2.0).grow_threshold == 2.0  # hysteresis low <= high
+    with pytest.raises(ValueError, match="--polarity"):
+        make_detector(polarity="grey")
+    with pytest.raises(ValueError, match="--threshold"):
+        make_detector(threshold=0.0)
+    with pytest.raises(ValueError, match=r"--model .*missing\.onnx"):
+        make_detector(tmp_path / "missing.onnx")
+    model = tmp_path / "m.onnx"
+    model.write_bytes(b"not really a model")
+    with pytest.raises(ValueError, match="--threshold: a model score"):
+        make_detector(model, threshold=6.0)
+    monkeypatch.setitem(sys.modules, "onnxruntime", None)  # as if not installed
+    with pytest.raises(ValueError, match=r"--model .*pip install onnxruntime"):
+        make_detector(model)
 
 
 def test_onnx_detector_maps_model_boxes_back_through_the_letterbox(tmp_path):

@@ -32,6 +32,7 @@ from seawatch.cli._common import (
     progress_bar,
     warnings_to_stderr,
 )
+from seawatch.cli.detect_cmds import ModelOption, PolarityOption, TemporalOption, ThresholdOption
 
 app = typer.Typer(
     name="seawatch",
@@ -321,6 +322,10 @@ def batch(
     attitude: Annotated[str, typer.Option(help="auto, horizon or file.")] = "auto",
     video: Annotated[bool, typer.Option(help="Write annotated.mp4 per recording.")] = True,
     report: Annotated[bool, typer.Option(help="Write report.html per recording.")] = True,
+    model: ModelOption = None,
+    threshold: ThresholdOption = None,
+    polarity: PolarityOption = "both",
+    temporal: TemporalOption = False,
     workers: Annotated[
         int | None,
         typer.Option(help="Local Dask worker processes (default: the cores; 1: no Dask).", min=1),
@@ -354,6 +359,12 @@ def batch(
                 attitude=attitude,
                 annotate=video,
                 report=report,
+                detector_options={
+                    "model": model,
+                    "threshold": threshold,
+                    "polarity": polarity,
+                    "temporal": temporal,
+                },
                 progress=lambda done, total: bar.update(task, completed=done, total=total),
             )
         if json_out:

@@ -47,7 +47,6 @@ __all__ = [
     "PolarityOption",
     "TemporalOption",
     "ThresholdOption",
-    "build_detector",
     "detect",
 ]
 
@@ -56,7 +55,8 @@ CSV_COLUMNS = ("index", "file", "time", "x", "y", "w", "h", "score", "u_wl", "v_
 
 _BOX_KEYS = ("x", "y", "w", "h", "score", "u_wl", "v_wl")
 
-# the detector's options, shared by `seawatch detect` and `seawatch track`
+# the detector's options (seawatch.vision.external.make_detector), shared by
+# `seawatch detect`, `track` and `batch`
 ModelOption = Annotated[
     Path | None,
     typer.Option(
@@ -76,9 +76,10 @@ ThresholdOption = Annotated[
 PolarityOption = Annotated[
     str,
     typer.Option(
-        help="Ships the classical detector looks for: both, dark (darker than the sea: "
-        "looking into the sun, where every hull is a silhouette and the bright boxes are "
-        "sun glitter) or bright (a thermal camera's warm hulls).",
+        help="Ships the classical detector looks for in luma: both, dark (darker than the "
+        "sea: looking into the sun, where hulls are silhouettes and the bright boxes sun "
+        "glitter) or bright (a thermal camera's warm hulls); a hull of another colour than "
+        "the sea is found by its chroma either way.",
     ),
 ]
 TemporalOption = Annotated[
@@ -89,36 +90,6 @@ TemporalOption = Annotated[
         "clutter in video; off by default).",
     ),
 ]
-
-
-def build_detector(
-    model: Path | None, threshold: float | None, polarity: str = "both", temporal: bool = False
-) -> Any:
-    """The ship detector of the detector options: an ONNX model (``--model``) or the
-    classical detector; :class:`BadInput` naming the option for a bad value."""
-    from seawatch.vision.detect import ClassicalShipDetector
-    from seawatch.vision.external import OnnxDetector
-
-    if polarity not in ("both", "dark", "bright"):
-        raise BadInput(f"--polarity: expected both, dark or bright, got {polarity!r}")
-    if model is not None:
-        if not model.is_file():
-            raise BadInput(f"--model {model}: no such ONNX model file")
-        if threshold is not None and threshold > 1:
-            raise BadInput(f"--threshold: a model score in [0, 1], got {threshold}")
-        try:
-            return OnnxDetector(model, score_threshold=0.25 if threshold is None else threshold)
-        except ImportError as exc:
-            raise BadInput(f"--model {model}: {exc}") from None
-    thr = 6.0 if threshold is None else threshold
-    if not thr > 0:
-        raise BadInput(f"--threshold: expected a number of noise units > 0, got {thr}")
-    return ClassicalShipDetector(
-        threshold=thr,
-        grow_threshold=min(3.0, thr),
-        temporal=temporal,
-        polarity=polarity,  # type: ignore[arg-type]
-    )
 
 
 def _record(frame: Any, boxes: Any) -> dict[str, Any]:
@@ -191,11 +162,12 @@ def detect(
     Example: [cyan]seawatch detect clip.mp4 --json -o boxes.csv[/]
     """
     from seawatch.io.video import VideoReader
+    from seawatch.vision.external import make_detector
 
     with exit_codes(), warnings_to_stderr():
         if end is not None and end <= start:
             raise BadInput(f"--end: must be after --start ({start} s), got {end} s")
-        detector = build_detector(model, threshold, polarity, temporal)
+        detector = make_detector(model, threshold=threshold, polarity=polarity, temporal=temporal)
         reader = VideoReader(
             source, step=step, start=start, end=end, max_frames=max_frames, fps=fps
         )

@@ -24,7 +24,6 @@ from seawatch.cli.detect_cmds import (
     PolarityOption,
     TemporalOption,
     ThresholdOption,
-    build_detector,
 )
 
 
@@ -162,12 +161,13 @@ def track(
     clip/video.mp4 --camera clip/camera.yaml --truth clip/truth.csv --out out/track --json[/]
     """
     from seawatch.pipeline import check_options, error_summary, track_video
+    from seawatch.vision.external import make_detector
 
     with exit_codes(), warnings_to_stderr():
         if filter not in ("afkf", "fkf", "kf"):
             raise BadInput(f"--filter: expected afkf, fkf or kf, got {filter!r}")
         check_options(estimator, attitude)
-        detector = build_detector(model, threshold, polarity, temporal)
+        detector = make_detector(model, threshold=threshold, polarity=polarity, temporal=temporal)
         inputs = _load_inputs(camera, platform, ais, truth, start)
         live = "://" in source or source.isdigit() or source.startswith("/dev/")
         with progress_bar() as bar, _terminate_as_interrupt():

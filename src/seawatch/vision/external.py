@@ -7,7 +7,9 @@ protocol ``detector(image, *, sea_mask=None, horizon=None)`` and return
 
 * :class:`CallableDetector` — any user function that returns boxes;
 * :class:`OnnxDetector` — a YOLO-style ONNX model through onnxruntime (optional extra),
-  its raw output decoded by :func:`decode_yolo`.
+  its raw output decoded by :func:`decode_yolo`;
+* :func:`make_detector` — the detector of the command line's detector options (an ONNX
+  model or the classical detector), for ``seawatch detect``, ``track`` and ``batch``.
 
 Their boxes get the water-line point of :func:`seawatch.vision.detect.waterline_points`
 (the hull/sea edge inside the box) and are kept only on the sea, as the classical
@@ -30,7 +32,7 @@ from seawatch.vision.detect import Detections, _horizon_ends, _in_sea, _sea_mask
 from seawatch.vision.planes import _gray
 from seawatch.vision.waterline import waterline_points
 
-__all__ = ["CallableDetector", "OnnxDetector", "decode_yolo"]
+__all__ = ["CallableDetector", "OnnxDetector", "decode_yolo", "make_detector"]
 
 
 def _in_sea_boxes(
@@ -389,3 +391,58 @@ class OnnxDetector:
         if self.filter_sea:
             det = _in_sea_boxes(det, g.shape, sea_mask, horizon, self.horizon_tolerance)
         return det
+
+
+# --------------------------------------------------------------------------------------
+# the command line's detector options
+# --------------------------------------------------------------------------------------
+
+
+def make_detector(
+    model: str | Path | None = None,
+    *,
+    threshold: float | None = None,
+    polarity: str = "both",
+    temporal: bool = False,
+) -> Any:
+    """The ship detector of the detector options of ``seawatch detect``/``track``/``batch``.
+
+    Args:
+        model: a YOLO-style ONNX model (:class:`OnnxDetector`); None: the classical
+            detector (:class:`~seawatch.vision.detect.ClassicalShipDetector`).
+        threshold: the model's score threshold in [0, 1] (default 0.25), or the classical
+            detector's threshold in noise units (default 6; its hysteresis low threshold
+            is min(3, threshold)).
+        polarity: ships the classical detector looks for in luma: ``both``, ``dark``
+            (looking into the sun, hulls are silhouettes and bright boxes are glitter) or
+            ``bright`` (a thermal camera's warm hulls); a hull of another colour than the
+            sea is found by its chroma either way.
+        temporal: the classical detector's temporal clutter model.
+
+    Raises:
+        ValueError: naming the option (``--model``, ``--threshold``, ``--polarity``) for a
+            missing model file, a missing onnxruntime or a bad value.
+    """
+    from seawatch.vision.detect import ClassicalShipDetector
+
+    if polarity not in ("both", "dark", "bright"):
+        raise ValueError(f"--polarity: expected both, dark or bright, got {polarity!r}")
+    if model is not None:
+        path = Path(model)
+        if not path.is_file():
+            raise ValueError(f"--model {path}: no such ONNX model file")
+        if threshold is not None and not 0.0 <= threshold <= 1.0:
+            raise ValueError(f"--threshold: a model score in [0, 1], got {threshold}")
+        try:
+            return OnnxDetector(path, score_threshold=0.25 if threshold is None else threshold)
+        except ImportError as exc:
+            raise ValueError(f"--model {path}: {exc}") from None
+    thr = 6.0 if threshold is None else float(threshold)
+    if not thr > 0:
+        raise ValueError(f"--threshold: expected a number of noise units > 0, got {thr}")
+    return ClassicalShipDetector(
+        threshold=thr,
+        grow_threshold=min(3.0, thr),
+        temporal=temporal,
+        polarity=polarity,  # type: ignore[arg-type]
+    )
