@@ -78,8 +78,8 @@ PolarityOption = Annotated[
     typer.Option(
         help="Ships the classical detector looks for in luma: both, dark (darker than the "
         "sea: looking into the sun, where hulls are silhouettes and the bright boxes sun "
-        "glitter) or bright (a thermal camera's warm hulls); a hull of another colour than "
-        "the sea is found by its chroma either way.",
+        "glitter) or bright (brighter than the sea); a hull of another colour than the "
+        "sea is found by its chroma either way.",
     ),
 ]
 TemporalOption = Annotated[

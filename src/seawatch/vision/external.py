@@ -415,8 +415,10 @@ def make_detector(
             is min(3, threshold)).
         polarity: ships the classical detector looks for in luma: ``both``, ``dark``
             (looking into the sun, hulls are silhouettes and bright boxes are glitter) or
-            ``bright`` (a thermal camera's warm hulls); a hull of another colour than the
-            sea is found by its chroma either way.
+            ``bright``; a hull of another colour than the sea is found by its chroma
+            either way. (On the MarDCT thermal frames ``bright`` finds the same boat as
+            ``both`` with more false boxes, 25 against 13 in 88 frames: the arbitration
+            between the polarities also removes clutter.)
         temporal: the classical detector's temporal clutter model.
 
     Raises:
