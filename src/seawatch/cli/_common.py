@@ -14,7 +14,7 @@ import warnings
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Annotated, Any, TextIO
 
 import numpy as np
 import typer
@@ -29,6 +29,32 @@ err = Console(stderr=True, soft_wrap=True)  # never break a path or message acro
 
 class BadInput(ValueError):
     """A user-supplied input (file, option, value) is invalid: exit code 2."""
+
+
+# the source and frame-selection options of the commands that read frames
+SourceArgument = Annotated[
+    str,
+    typer.Argument(
+        help="Video file, image file, image folder, stream URL (rtsp://, http://) "
+        "or camera (0, /dev/video0)."
+    ),
+]
+StepOption = Annotated[int, typer.Option(help="Use every STEP-th frame.", min=1)]
+FpsOption = Annotated[
+    float | None,
+    typer.Option(help="Frame rate of an image folder (times = index / fps); default 1."),
+]
+StartOption = Annotated[float, typer.Option(help="First time to process [s].", min=0.0)]
+EndOption = Annotated[float | None, typer.Option(help="Time to stop at [s] (exclusive).", min=0.0)]
+MaxFramesOption = Annotated[
+    int | None, typer.Option("--max-frames", help="Stop after this many frames.", min=1)
+]
+
+
+def check_span(start: float, end: float | None) -> None:
+    """:class:`BadInput` naming ``--end`` unless it is after ``--start`` (or absent)."""
+    if end is not None and end <= start:
+        raise BadInput(f"--end: must be after --start ({start} s), got {end} s")
 
 
 def _plain(obj: Any) -> Any:

@@ -32,7 +32,13 @@ from typing import Annotated, Any
 import typer
 
 from seawatch.cli._common import (
-    BadInput,
+    EndOption,
+    FpsOption,
+    MaxFramesOption,
+    SourceArgument,
+    StartOption,
+    StepOption,
+    check_span,
     emit_json,
     err,
     exit_codes,
@@ -113,13 +119,7 @@ def _csv_rows(rec: dict[str, Any]) -> list[list[str]]:
 
 
 def detect(
-    source: Annotated[
-        str,
-        typer.Argument(
-            help="Video file, image file, image folder, stream URL (rtsp://, http://) "
-            "or camera (0, /dev/video0)."
-        ),
-    ],
+    source: SourceArgument,
     json_out: Annotated[
         bool, typer.Option("--json", help="Print the detection JSON on stdout.")
     ] = False,
@@ -139,18 +139,11 @@ def detect(
         ),
     ] = True,
     temporal: TemporalOption = False,
-    step: Annotated[int, typer.Option(help="Use every STEP-th frame.", min=1)] = 1,
-    fps: Annotated[
-        float | None,
-        typer.Option(help="Frame rate of an image folder (times = index / fps); default 1."),
-    ] = None,
-    start: Annotated[float, typer.Option(help="First time to process [s].", min=0.0)] = 0.0,
-    end: Annotated[
-        float | None, typer.Option(help="Time to stop at [s] (exclusive).", min=0.0)
-    ] = None,
-    max_frames: Annotated[
-        int | None, typer.Option("--max-frames", help="Stop after this many frames.", min=1)
-    ] = None,
+    step: StepOption = 1,
+    fps: FpsOption = None,
+    start: StartOption = 0.0,
+    end: EndOption = None,
+    max_frames: MaxFramesOption = None,
 ) -> None:
     """Detect ships in every frame of a video, stream or image folder.
 
@@ -165,8 +158,7 @@ def detect(
     from seawatch.vision.external import make_detector
 
     with exit_codes(), warnings_to_stderr():
-        if end is not None and end <= start:
-            raise BadInput(f"--end: must be after --start ({start} s), got {end} s")
+        check_span(start, end)
         detector = make_detector(model, threshold=threshold, polarity=polarity, temporal=temporal)
         reader = VideoReader(
             source, step=step, start=start, end=end, max_frames=max_frames, fps=fps

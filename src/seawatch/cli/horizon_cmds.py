@@ -31,7 +31,13 @@ from typing import Annotated, Any
 import typer
 
 from seawatch.cli._common import (
-    BadInput,
+    EndOption,
+    FpsOption,
+    MaxFramesOption,
+    SourceArgument,
+    StartOption,
+    StepOption,
+    check_span,
     emit_json,
     err,
     exit_codes,
@@ -72,13 +78,7 @@ def _csv_row(rec: dict[str, Any]) -> list[str]:
 
 
 def horizon(
-    source: Annotated[
-        str,
-        typer.Argument(
-            help="Video file, image file, image folder, stream URL (rtsp://, http://) "
-            "or camera (0, /dev/video0)."
-        ),
-    ],
+    source: SourceArgument,
     json_out: Annotated[
         bool, typer.Option("--json", help="Print the horizon JSON on stdout.")
     ] = False,
@@ -86,18 +86,11 @@ def horizon(
         Path | None,
         typer.Option("--output", "-o", help="CSV file, one row per frame, written as it goes."),
     ] = None,
-    step: Annotated[int, typer.Option(help="Use every STEP-th frame.", min=1)] = 1,
-    fps: Annotated[
-        float | None,
-        typer.Option(help="Frame rate of an image folder (times = index / fps); default 1."),
-    ] = None,
-    start: Annotated[float, typer.Option(help="First time to process [s].", min=0.0)] = 0.0,
-    end: Annotated[
-        float | None, typer.Option(help="Time to stop at [s] (exclusive).", min=0.0)
-    ] = None,
-    max_frames: Annotated[
-        int | None, typer.Option("--max-frames", help="Stop after this many frames.", min=1)
-    ] = None,
+    step: StepOption = 1,
+    fps: FpsOption = None,
+    start: StartOption = 0.0,
+    end: EndOption = None,
+    max_frames: MaxFramesOption = None,
     smooth: Annotated[
         bool | None,
         typer.Option(
@@ -122,8 +115,7 @@ def horizon(
     from seawatch.vision.horizon import HorizonTracker, detect_horizon
 
     with exit_codes(), warnings_to_stderr():
-        if end is not None and end <= start:
-            raise BadInput(f"--end: must be after --start ({start} s), got {end} s")
+        check_span(start, end)
         reader = VideoReader(
             source, step=step, start=start, end=end, max_frames=max_frames, fps=fps
         )

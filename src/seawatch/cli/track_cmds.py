@@ -13,6 +13,8 @@ import typer
 from seawatch.cli._common import (
     EXIT_FAILED,
     BadInput,
+    MaxFramesOption,
+    StepOption,
     emit_json,
     err,
     exit_codes,
@@ -133,10 +135,8 @@ def track(
     pixel_sigma: Annotated[
         float, typer.Option(help="1-sigma of the water-line pixel [px].", min=0.01)
     ] = 1.0,
-    step: Annotated[int, typer.Option(help="Use every STEP-th frame.", min=1)] = 1,
-    max_frames: Annotated[
-        int | None, typer.Option(help="Stop after this many frames.", min=1)
-    ] = None,
+    step: StepOption = 1,
+    max_frames: MaxFramesOption = None,
     video: Annotated[bool, typer.Option(help="Write annotated.mp4.")] = True,
     report: Annotated[bool, typer.Option(help="Write report.html.")] = True,
     parquet: Annotated[bool, typer.Option(help="Also write tracks.parquet (pyarrow).")] = False,
