@@ -266,3 +266,73 @@ def test_dark_polarity_into_the_sun_drops_the_glitter_tracks_and_keeps_the_ferry
     assert both["tp"] >= 0.9 * both["truth_rows"] and dark["tp"] >= 0.9 * dark["truth_rows"]
     assert both["fp"] > 2 * both["truth_rows"]  # the glitter's boxes, confirmed as tracks
     assert dark["fp"] < 0.3 * dark["truth_rows"] and dark["mota"] > 0.6
+
+
+def _two_sizes(clip: Path, path: Path, size: tuple[int, int], at: int = 40) -> Path:
+    """The clip's frames as two transport streams back to back: frames before ``at`` as
+    they are, the rest scaled to ``size`` (a stream whose resolution changes)."""
+    import cv2
+
+    from seawatch.io.video import VideoReader, VideoWriter
+
+    parts = []
+    for k, (lo, hi) in enumerate(((0, at), (at, None))):
+        part = path.with_name(f"{path.stem}-{k}.ts")
+        with VideoWriter(part, 25.0, gop=5) as writer, VideoReader(clip / "video.mp4") as reader:
+            for fr in reader:
+                if fr.index >= lo and (hi is None or fr.index < hi):
+                    image = fr.image if k == 0 else cv2.resize(fr.image, size, cv2.INTER_AREA)
+                    writer.write(image)
+        parts.append(part.read_bytes())
+    path.write_bytes(b"".join(parts))
+    return path
+
+
+def test_a_resolution_change_scales_the_camera_and_restarts_the_tracks(clip, tmp_path):
+    """A camera file calibrated at 1920×1080 on a 960×540 stream that drops to 640×360 at
+    frame 40: the intrinsics are scaled to each size (warnings say so), the visual tracks
+    restart with new ids, and the azimuths stay within 0.1° of the truth on both sides
+    (before: with a camera file of the first size, 8.4° off after the change, and with
+    annotated.mp4 on, exit 2 at frame 40); annotated.mp4 holds every frame at the first
+    size."""
+    from seawatch.io.video import VideoReader
+
+    video = _two_sizes(clip, tmp_path / "joined.ts", (640, 360))
+    big = tmp_path / "camera1080.yaml"
+    save_camera(load_camera(clip / "camera.yaml").resized((1920, 1080)), big)
+    res = runner.invoke(app, ["track", str(video), "--camera", str(big), "--out",
+                              str(tmp_path / "out"), "--no-report", "--json"])  # fmt: skip
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout[res.stdout.index("{") :])
+    notes = " ".join(doc["warnings"])
+    assert "calibrated for 1920x1080 frames" in notes and "scaled by 0.5" in notes
+    assert "scaled by 0.3333" in notes
+    assert "frame 40: the frame size changed from 960x540 to 640x360" in notes
+    truth = {int(r["frame"]): float(r["azimuth_deg"]) for r in _rows(clip / "truth.csv")}
+    rows = [r for r in _rows(tmp_path / "out" / "tracks.csv") if r["azimuth_deg"]]
+    before = [r for r in rows if int(r["frame"]) < 40]
+    after = [r for r in rows if int(r["frame"]) >= 40]
+    assert len(before) > 20 and len(after) > 20
+    assert {r["track_id"] for r in before}.isdisjoint({r["track_id"] for r in after})
+    for r in rows:
+        assert abs(float(r["azimuth_deg"]) - truth[int(r["frame"])]) < 0.1, r
+    with VideoReader(tmp_path / "out" / "annotated.mp4") as annotated:
+        frames = list(annotated)
+    assert len(frames) == 80 and {f.image.shape[:2] for f in frames} == {(540, 960)}
+
+
+def test_a_change_to_another_aspect_ratio_stops_geo_referencing_with_exit_2(clip, tmp_path):
+    """640×480 after 960×540: no scaling maps those pixels to the calibrated ones — exit 2
+    naming the camera and the new size, every row before it kept; without a camera the
+    pixel tracks go on."""
+    video = _two_sizes(clip, tmp_path / "joined.ts", (640, 480))
+    out = tmp_path / "out"
+    res = runner.invoke(app, ["track", str(video), "--camera", str(clip / "camera.yaml"),
+                              "--out", str(out), "--no-report"])  # fmt: skip
+    assert res.exit_code == 2
+    assert "--camera: calibrated for 960x540" in res.output and "640x480" in res.output
+    frames = {int(r["frame"]) for r in _rows(out / "tracks.csv")}
+    assert frames and max(frames) < 40
+    res = runner.invoke(app, ["track", str(video), "--out", str(tmp_path / "px")])
+    assert res.exit_code == 0, res.output
+    assert max(int(r["frame"]) for r in _rows(tmp_path / "px" / "tracks.csv")) >= 70

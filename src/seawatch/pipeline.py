@@ -5,7 +5,10 @@ This module only wires the stages (STYLE.md); each stage is its own module:
 1. frames — :class:`seawatch.io.video.VideoReader` (file, image folder, stream, device);
 2. image stage — :class:`seawatch.vision.tracker.VisualTracker`: horizon, ship boxes,
    visual tracks with their water-line pixel (seed 001, ALGORITHMS.md §1);
-3. camera pose per frame — the camera file's intrinsics, height and attitude; on a
+3. camera pose per frame — the camera file's intrinsics (scaled to the frames when
+   they are the same view at another resolution, also when a stream's resolution
+   changes; frames of another aspect ratio stop the job as bad input), height and
+   attitude; on a
    moving platform the NAV pose (:mod:`seawatch.io.nav`) gives position and heading; the
    detected horizon refines pitch and roll (:func:`seawatch.camera.attitude_from_horizon`,
    §4.3) when it is found with confidence and lies within :data:`HORIZON_TOLERANCE` of
@@ -26,6 +29,10 @@ This module only wires the stages (STYLE.md); each stage is its own module:
    (every estimator, long form), ``tracks.geojson`` (rewritten about once per second of
    video), ``annotated.mp4`` (fragmented MP4), and at the end ``report.html`` and, with a
    truth file, the errors of :func:`seawatch.metrics.track_errors.score_tracks`.
+
+A frame-size change mid-stream restarts the visual tracks (new ids; their pixels are
+another grid's) and is noted in the run's warnings; ``annotated.mp4`` keeps the first
+size.
 
 Times: video time [s] from the first frame; ``start`` [s since 1970-01-01 UTC] is the
 absolute time of frame 0, needed to align NAV and AIS (``seawatch synth ais`` writes it
@@ -95,6 +102,10 @@ estimator (long form)."""
 
 PIXEL_SIGMA = 1.0
 """Default 1-σ of the water-line pixel [px] (detector jitter plus quantisation)."""
+
+ASPECT_TOLERANCE = 0.01
+"""Frames whose aspect ratio is within this fraction of the camera file's are the same
+view at another resolution: the intrinsics are scaled to them (:func:`_camera_for`)."""
 
 COAST_SECONDS = 3.0
 """How long a confirmed track survives without detections, by prediction [s] (at least
@@ -375,6 +386,23 @@ def check_options(estimator: str, attitude: str) -> None:
         raise ValueError(f"--attitude: expected auto, horizon or file, got {attitude!r}")
 
 
+def _camera_for(camera: PinholeCamera, size: tuple[int, int], where: str) -> PinholeCamera:
+    """The camera for frames of ``size`` = (width, height) [px]: the camera itself, or
+    its :meth:`~seawatch.camera.PinholeCamera.resized` copy for the same view at another
+    resolution (aspect ratios within 1 %). ValueError naming ``--camera`` and ``where``
+    for another aspect ratio: a crop or another camera, whose pixels cannot be told
+    apart from the calibrated ones' by their size alone."""
+    if size == camera.image_size:
+        return camera
+    (cw, ch), (w, h) = camera.image_size, size
+    if abs((w / h) / (cw / ch) - 1.0) > ASPECT_TOLERANCE:
+        raise ValueError(
+            f"--camera: calibrated for {cw}x{ch} frames, {where} is {w}x{h} (another aspect "
+            "ratio: a crop or another camera); calibrate the camera for this stream"
+        )
+    return camera.resized(size)
+
+
 def track_video(
     source: str | Path,
     out_dir: str | Path,
@@ -518,8 +546,31 @@ def track_video(
     # the next frames are decoded in one thread and their horizons and ships found in
     # another (VisualTracker.stream) while this one is tracked and written
     frames_ahead = vtracker.stream(reader)
+    size: tuple[int, int] | None = None
     try:
         for frame, horizon, detections in frames_ahead:
+            shape = frame.image.shape
+            if (shape[1], shape[0]) != size:
+                if size is not None:  # the stream's resolution changed (VideoReader warns)
+                    note(
+                        f"frame {frame.index}: the frame size changed from {size[0]}x{size[1]} "
+                        f"to {shape[1]}x{shape[0]}: the visual tracks restart with new ids"
+                    )
+                    vtracker.restart_tracks()
+                    if world is not None:
+                        world.drop(np.fromiter(live_ids, np.int64))
+                        live_ids = set()
+                size = (shape[1], shape[0])
+                if pose is not None and camera is not None:
+                    where = f"frame {frame.index} of {source}"
+                    pose.camera = _camera_for(camera, size, where)
+                    if size != camera.image_size:
+                        s = size[0] / camera.image_size[0]
+                        note(
+                            f"--camera: calibrated for {camera.image_size[0]}x"
+                            f"{camera.image_size[1]} frames, {where} is {size[0]}x{size[1]}: "
+                            f"the intrinsics are scaled by {s:.4g}"
+                        )
             rows = vtracker.update(detections)
             t = float(frame.time)
             k = rows.shape[0]
@@ -607,7 +658,9 @@ def track_video(
 
                     h, w = frame.image.shape[:2]
                     video_out = AnnotatedVideo(out / "annotated.mp4", fps / step, (w, h))
-                video_out.write(frame.image, records, horizon, time=t, frame=int(frame.index))
+                video_out.write(
+                    frame.image, records, horizon, time=t, frame=int(frame.index), fit=True
+                )
             frames += 1
             if progress is not None:
                 progress(frames, total)

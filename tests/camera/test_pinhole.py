@@ -163,6 +163,39 @@ def test_rays_are_unit_and_the_principal_ray_is_the_optical_axis():
     )
 
 
+@given(
+    name=st.sampled_from(sorted(CAMERAS)),
+    scale=st.sampled_from([0.25, 0.5, 2 / 3, 1.5, 2.0]),
+    daz=st.floats(-30.0, 30.0),
+    del_=st.floats(-20.0, 20.0),
+)
+def test_resized_camera_sees_each_direction_at_the_scaled_pixel(name, scale, daz, del_):
+    """The same view sampled on a grid ``scale`` times as fine: a direction seen at pixel
+    p (centres at integers) is seen at scale (p + ½) − ½, lens distortion included; the
+    angles of a pixel are those of its scaled pixel, and the attitude is kept."""
+    cam = CAMERAS[name].with_attitude(0.3, math.radians(-2.0), math.radians(1.5))
+    w, h = cam.image_size
+    small = cam.resized((round(w * scale), round(h * scale)))
+    assert small.image_size == (round(w * scale), round(h * scale))
+    assert (small.heading, small.pitch, small.roll, small.dist) == (
+        cam.heading, cam.pitch, cam.roll, cam.dist)  # fmt: skip
+    az, el = 0.3 + math.radians(daz), math.radians(-2.0 + del_)
+    uv = cam.angles_to_pixel(az, el)
+    assume(np.all(np.isfinite(uv)) and -0.5 <= uv[0] <= w - 0.5 and -0.5 <= uv[1] <= h - 0.5)
+    sx, sy = small.image_size[0] / w, small.image_size[1] / h
+    expected = [sx * (uv[0] + 0.5) - 0.5, sy * (uv[1] + 0.5) - 0.5]
+    np.testing.assert_allclose(small.angles_to_pixel(az, el), expected, rtol=0, atol=1e-6)
+    back = small.pixel_to_angles(expected)
+    assert abs(_ang_diff(back[0], az)) < 1e-9 and abs(back[1] - el) < 1e-9
+
+
+def test_resized_rejects_a_bad_size():
+    with pytest.raises(ValueError, match="image_size"):
+        IDEAL.resized((960, 0))
+    with pytest.raises(ValueError, match="image_size"):
+        IDEAL.resized((960.5, 540))
+
+
 # ---------------------------------------------------------------- round trips
 @given(
     name=st.sampled_from(sorted(CAMERAS)),

@@ -147,6 +147,21 @@ def test_annotated_video_decodes_with_right_frame_count_size_and_box_colour(tmp_
         assert np.linalg.norm(side - want) < np.linalg.norm(side - np.array(BG, float)) / 2
 
 
+def test_a_frame_of_another_size_is_drawn_at_its_size_and_fitted_to_the_video(tmp_path):
+    """fit=True (a stream whose resolution changed): a 160×120 frame with a box at its own
+    pixels comes out 320×240 with the box at twice them."""
+    path = tmp_path / "fit.mp4"
+    row = {"track_id": 2, "x": 40.0, "y": 60.0, "w": 30.0, "h": 12.0}
+    with AnnotatedVideo(path, 25.0, (320, 240), annotator=Annotator(thickness=2)) as video:
+        video.write(np.full((120, 160, 3), BG, np.uint8), [row], fit=True)
+    (frame,) = list(VideoReader(path))
+    assert frame.size == (320, 240)
+    want = np.array(track_colour(2), float)
+    side = frame.image[126:140, 80].astype(float)  # the left side at x = 2 × 40
+    away = frame.image[126:140, 70].astype(float)
+    assert np.linalg.norm(side.mean(0) - want) < np.linalg.norm(away.mean(0) - want) / 2
+
+
 def test_killed_writer_leaves_a_playable_file_missing_at_most_one_second(tmp_path):
     path = tmp_path / "annotated.mp4"
     n, fps = 100, 25

@@ -213,6 +213,30 @@ class PinholeCamera:
             **kwargs,
         )
 
+    def resized(self, image_size: tuple[int, int]) -> PinholeCamera:
+        """The same camera and view at another resolution (a stream scaled to
+        ``image_size`` = (width, height) [px]): with ``s_x = width / W`` and
+        ``s_y = height / H``, ``fx' = s_x fx``, ``cx' = s_x (cx + ½) − ½`` (pixel centres
+        at integers: the edge of the image stays the edge) and likewise in y; the lens
+        distortion acts on normalised coordinates and is unchanged, as are the attitude,
+        height and position. A ray seen at pixel ``p`` is seen at ``s (p + ½) − ½``."""
+        size = vector("image_size", image_size, 2)
+        if np.any(size < 1) or np.any(size != np.round(size)):
+            raise ValueError(
+                f"image_size: expected two positive integers (width, height) [px], "
+                f"got {image_size!r}"
+            )
+        sx = float(size[0]) / self.image_size[0]
+        sy = float(size[1]) / self.image_size[1]
+        return dataclasses.replace(
+            self,
+            fx=self.fx * sx,
+            fy=self.fy * sy,
+            cx=(self.cx + 0.5) * sx - 0.5,
+            cy=(self.cy + 0.5) * sy - 0.5,
+            image_size=(int(size[0]), int(size[1])),
+        )
+
     def with_attitude(
         self, heading: float | None = None, pitch: float | None = None, roll: float | None = None
     ) -> PinholeCamera:

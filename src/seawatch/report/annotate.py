@@ -325,16 +325,25 @@ class AnnotatedVideo:
         *,
         time: float | None = None,
         frame: int | None = None,
+        fit: bool = False,
     ) -> None:
-        """Annotate one frame (:meth:`Annotator.draw`) and append it to the video."""
+        """Annotate one frame (:meth:`Annotator.draw`) and append it to the video.
+
+        ``fit``: a frame of another size than the video's (a stream whose resolution
+        changed) is drawn at its own size and then scaled to the video's; without it such
+        a frame is a ValueError."""
         shape = np.shape(image)
-        if len(shape) < 2 or (shape[1], shape[0]) != self.size:
+        other = len(shape) < 2 or (shape[1], shape[0]) != self.size
+        if other and not (fit and len(shape) >= 2 and min(shape[:2]) >= 1):
             raise ValueError(
                 f"image: frame {self.frames_written} is "
                 f"{shape[1] if len(shape) > 1 else '?'}x{shape[0] if shape else '?'}, "
                 f"the video is {self.size[0]}x{self.size[1]}"
             )
-        self._writer.write(self.annotator.draw(image, tracks, horizon, time=time, frame=frame))
+        drawn = self.annotator.draw(image, tracks, horizon, time=time, frame=frame)
+        if other:
+            drawn = cv2.resize(drawn, self.size, interpolation=cv2.INTER_AREA)
+        self._writer.write(drawn)
 
     def close(self) -> None:
         """Finish the file (idempotent; no frames → no file, with a warning)."""

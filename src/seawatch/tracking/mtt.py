@@ -415,8 +415,10 @@ class MultiTargetTracker:
             raise ValueError("filter_options: only for filter classes, not for a factory")
         return factory
 
-    def reset(self) -> None:
-        """Forget all tracks (ids restart at 1) and the last scan time."""
+    def reset(self, *, keep_ids: bool = False) -> None:
+        """Forget all tracks and the last scan time; ids restart at 1, or with
+        ``keep_ids`` continue after the last one given (the same stream, tracked anew)."""
+        next_id = getattr(self, "_next_id", 1) if keep_ids else 1
         self._X = np.empty((0, _N))
         self._P = np.empty((0, _N, _N))
         self._ids = np.empty(0, np.int64)
@@ -427,7 +429,7 @@ class MultiTargetTracker:
         self._confirmed = np.empty(0, bool)
         self._size = np.empty((0, 2))
         self._filters: list[TrackFilter] = []
-        self._next_id = 1
+        self._next_id = next_id
         self._time: float | None = None
         self._anchored: tuple[NDArray[np.int64], FloatArray, NDArray[np.bool_]] | None = None
         self._S: FloatArray | None = None

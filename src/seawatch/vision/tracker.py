@@ -218,6 +218,12 @@ class VisualTracker:
         if callable(reset):
             reset()
 
+    def restart_tracks(self) -> None:
+        """Forget the tracks, not the horizon nor the detector (a frame-size change: the
+        tracks' pixels are another grid's); new tracks continue the ids."""
+        self.mtt.reset(keep_ids=True)
+        self._offsets.clear()
+
     # ------------------------------------------------------------------ per frame
     def horizon(self, image: ArrayLike, time: float | None = None) -> Any:
         """The horizon of the next frame (the smoothed :class:`~seawatch.vision.horizon.
