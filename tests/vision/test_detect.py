@@ -765,11 +765,17 @@ def test_rendered_footage_water_line_matches_truth_within_the_renderers_fill(tmp
 
 
 @needs_mardct
+@pytest.mark.parametrize("grey", [False, True], ids=["as-stored", "one-channel"])
 @pytest.mark.parametrize("refine", REFINE)
-def test_mardct_thermal_boat_recall_at_least_0_9_with_at_most_half_a_false_box_per_frame(refine):
+def test_mardct_thermal_boat_recall_at_least_0_9_with_at_most_half_a_false_box_per_frame(
+    refine, grey
+):
     """Issue 6 target on real pixels: a detection centre within 12 px (city block) of the
     annotated box centre in ≥ 90 % of the 88 frames, ≤ 0.5 false boxes per frame. The
-    sea region comes from the horizon detector (the sea–land boundary here)."""
+    sea region comes from the horizon detector (the sea–land boundary here). The frames
+    are stored as RGBA; as a thermal camera gives them, one grey channel, they must do
+    as well (they gave 5.2 false boxes a frame when the horizon weighed one channel
+    less than three and was lost in 87 of the 88 frames)."""
     from seawatch.vision.horizon import detect_horizon
 
     rows = sorted(csv.DictReader((MARDCT / "boxes.csv").open()), key=lambda r: int(r["frame"]))
@@ -777,6 +783,8 @@ def test_mardct_thermal_boat_recall_at_least_0_9_with_at_most_half_a_false_box_p
     hits = false = 0
     for r in rows:
         img = cv2.imread(str(MARDCT / "images" / r["file"]), cv2.IMREAD_UNCHANGED)
+        if grey:
+            img = cv2.cvtColor(img, cv2.COLOR_BGRA2GRAY)
         boxes = det(img, horizon=detect_horizon(img))
         x, y, w, h = (float(r[k]) for k in "xywh")
         d = np.abs(boxes.centers - [x + w / 2, y + h / 2]).sum(axis=1)

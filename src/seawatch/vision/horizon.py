@@ -1272,7 +1272,12 @@ def _strip_features(
 ) -> np.ndarray:
     """Cumulative row sums (h + 1, S, C + 1) of strip-mean features: the colour channels
     and the texture ``|∇g|`` (Gaussian σ = 1 px), each divided by its robust spread (10th
-    to 90th percentile over the strip means), so that distances are in spread units."""
+    to 90th percentile over the strip means), so that distances are in spread units.
+
+    A grey frame's one channel is weighted √3: distances are then those of the same
+    frame stored as BGR (three equal channels), so a thermal camera's 1-channel frames
+    and their 3-channel copies give one line (before, the 1-channel MarDCT frames lost
+    the horizon in 19 of their first 20 frames that their RGBA copies keep)."""
     h = colour.shape[0]
     tex = cv2.GaussianBlur(np.abs(gx) + np.abs(gy), (0, 0), 1.0)
     col = cv2.resize(colour, (n_strips, h), interpolation=cv2.INTER_AREA).reshape(h, n_strips, -1)
@@ -1280,6 +1285,8 @@ def _strip_features(
     F = np.concatenate([col, tx], axis=2)
     q1, q9 = _percentiles(F.reshape(-1, F.shape[2]), (10.0, 90.0), axis=0)
     F = F / np.maximum(q9 - q1, 1e-3)
+    if colour.shape[2] == 1:
+        F[..., 0] *= math.sqrt(3.0)
     cum = np.zeros((h + 1, n_strips, F.shape[2]), dtype=np.float64)
     np.cumsum(F, axis=0, out=cum[1:])
     return cum
