@@ -8,12 +8,12 @@ This module only wires the stages (STYLE.md); each stage is its own module:
 3. camera pose per frame — the camera file's intrinsics (scaled to the frames when
    they are the same view at another resolution, also when a stream's resolution
    changes; frames of another aspect ratio stop the job as bad input), height and
-   attitude; on a
-   moving platform the NAV pose (:mod:`seawatch.io.nav`) gives position and heading; the
-   detected horizon refines pitch and roll (:func:`seawatch.camera.attitude_from_horizon`,
-   §4.3) when it is found with confidence and lies within :data:`HORIZON_TOLERANCE` of
-   the file's attitude — with ``attitude="horizon"``, and by default (``"auto"``) on a
-   moving platform, whose NAV gives no (or a coarse) pitch and roll;
+   attitude; on a moving platform the NAV pose (:mod:`seawatch.io.nav`) gives position
+   and heading; the detected horizon refines pitch and roll
+   (:func:`seawatch.camera.attitude_from_horizon`, §4.3) when it is found with
+   confidence and lies within :data:`HORIZON_TOLERANCE` of the file's attitude — with
+   ``attitude="horizon"``, and by default (``"auto"``) on a moving platform, whose NAV
+   gives no (or a coarse) pitch and roll;
 4. angles — water-line pixel → azimuth (clockwise from North) and depression (below the
    true horizontal) with their covariance for the pixel noise
    (:meth:`seawatch.camera.PinholeCamera.pixel_to_angles`, ``angle_covariance``);
