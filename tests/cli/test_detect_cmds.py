@@ -148,6 +148,26 @@ def test_polarity_keeps_the_dark_hull_or_the_bright_boat(tmp_path, polarity, kep
         assert _matches(f["boxes"], truth[kept]), (polarity, f["boxes"])
 
 
+def test_float_thermal_images_with_dead_pixels_are_detected_not_refused(tmp_path):
+    """Radiometric float TIFFs (kelvin) with NaN dead pixels: the reader fills them, the
+    ships are found and the summary counts the filled images (before: exit 2, "image:
+    contains NaN or inf pixels", on the first frame)."""
+    folder = tmp_path / "thermal"
+    folder.mkdir()
+    truths = []
+    for k in range(2):
+        img, boxes = scene(k, shift=4 * k)
+        kelvin = 270.0 + cv2.cvtColor(img, cv2.COLOR_BGR2GRAY).astype(np.float32) / 10.0
+        kelvin[[5, 150, 300], [7, 200, 470]] = np.nan
+        cv2.imwrite(str(folder / f"t{k}.tiff"), kelvin)
+        truths.append(boxes)
+    res = runner.invoke(app, [str(folder), "--json"])
+    assert res.exit_code == 0, res.output
+    assert "2 with NaN/inf pixels filled" in _msg(res)
+    for f, truth in zip(json.loads(res.stdout)["frames"], truths, strict=True):
+        assert _matches(f["boxes"], truth), f["boxes"]
+
+
 def test_human_readable_output_has_one_line_per_frame(tmp_path):
     folder, _ = _folder(tmp_path, n=2)
     res = runner.invoke(app, [str(folder)])

@@ -423,6 +423,35 @@ def test_non_image_and_broken_files_in_a_folder_are_skipped_with_warnings(tmp_pa
     assert frames[1].image.shape == (32, 48, 3)  # delivered despite the size change
 
 
+def test_nan_pixels_of_float_images_are_filled_and_an_all_nan_image_is_skipped(tmp_path: Path):
+    """A radiometric thermal camera's float TIFFs with dead (NaN) or saturated (inf)
+    pixels: each such pixel gets the median of the image's finite pixels (the first image
+    is reported, all are counted in ``filled``), the other pixels are untouched; an
+    image without a finite pixel is skipped and counted in ``skipped``."""
+    rng = np.random.default_rng(7)
+    images = []
+    for k in range(3):
+        img = (280.0 + rng.normal(0.0, 2.0, (32, 48))).astype(np.float32)
+        if k > 0:
+            img[3, 5], img[20, 40], img[31, 0] = np.nan, np.inf, -np.inf
+        images.append(img)
+        cv2.imwrite(str(tmp_path / f"t{k}.tiff"), img)
+    cv2.imwrite(str(tmp_path / "t3.tiff"), np.full((32, 48), np.nan, np.float32))
+    reader = VideoReader(tmp_path)
+    with pytest.warns(VideoWarning) as record:
+        frames = list(reader)
+    text = " ".join(str(w.message) for w in record)
+    assert "t1.tiff: 3 NaN or inf pixel(s)" in text and "t2.tiff: 3" not in text
+    assert "t3.tiff: no finite pixel" in text
+    assert (reader.filled, reader.skipped) == (2, 1)
+    assert [f.file.name for f in frames] == ["t0.tiff", "t1.tiff", "t2.tiff"]
+    np.testing.assert_array_equal(frames[0].image, images[0])
+    for f, img in zip(frames[1:], images[1:], strict=True):
+        ok = np.isfinite(img)
+        np.testing.assert_array_equal(f.image[ok], img[ok])
+        assert np.all(f.image[~ok] == np.median(img[ok]))
+
+
 def test_empty_folder_and_folder_without_images_are_clear_errors(tmp_path: Path):
     with pytest.raises(VideoError, match="no image files"):
         VideoReader(tmp_path)

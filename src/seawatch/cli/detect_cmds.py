@@ -177,6 +177,7 @@ def detect(
         err.print(
             f"{len(records)} frame(s), {n_boxes} box(es)"
             + (f", {reader.skipped} corrupt frame(s) skipped" if reader.skipped else "")
+            + (f", {reader.filled} with NaN/inf pixels filled" if reader.filled else "")
             + (f"; wrote {output}" if output is not None else "")
         )
         if json_out:

@@ -140,6 +140,7 @@ def horizon(
         err.print(
             f"{len(records)} frame(s), horizon found in {found}"
             + (f", {reader.skipped} corrupt frame(s) skipped" if reader.skipped else "")
+            + (f", {reader.filled} with NaN/inf pixels filled" if reader.filled else "")
             + (f"; wrote {output}" if output is not None else "")
         )
         if json_out:

@@ -251,6 +251,11 @@ class VideoReader:
     Attributes:
         skipped: frames lost to corruption (video) or undecodable image files (folder)
             during the last iteration.
+        filled: floating-point images (folder) whose NaN or inf pixels — a radiometric
+            thermal camera's dead or invalid pixels — were filled with the median of
+            the image's finite pixels during the last iteration (the first is reported
+            with a warning, the others only counted; an image without a finite pixel is
+            skipped and counted in ``skipped``).
         kind: ``"file"``, ``"folder"``, ``"image"``, ``"url"`` or ``"device"``.
     """
 
@@ -292,6 +297,7 @@ class VideoReader:
         self.timeout = float(timeout)
         self.backend = backend
         self.skipped = 0
+        self.filled = 0
         self.kind, self._target = _classify(source)
         self.source = str(source)
         self._folder_fps = 1.0 if fps is None else float(fps)
@@ -349,6 +355,7 @@ class VideoReader:
 
     def __iter__(self) -> Iterator[Frame]:
         self.skipped = 0
+        self.filled = 0
         if self.kind in ("folder", "image"):
             return self._iter_images()
         handle, self._handle = self._handle, None
@@ -414,6 +421,8 @@ class VideoReader:
                 continue
             try:
                 img = read_image(path, gray=self.gray)
+                if img.dtype == np.float32:
+                    img = self._fill_invalid(img, path)
             except VideoError as exc:
                 self.skipped += 1
                 warnings.warn(f"{exc}; skipped", VideoWarning, stacklevel=2)
@@ -433,6 +442,27 @@ class VideoReader:
                 return
         if decoded == 0 and kept > 0 and self.skipped > 0:
             raise VideoError(f"{self.source}: none of the {self.skipped} image files could be read")
+
+    def _fill_invalid(self, img: NDArray[Any], path: Path) -> NDArray[Any]:
+        """A floating-point image with its NaN/inf pixels filled with the median of its
+        finite ones (counted in :attr:`filled`, the first one reported); VideoError when
+        no pixel is finite."""
+        bad = ~np.isfinite(img)
+        if not bad.any():
+            return img
+        if bad.all():
+            raise VideoError(f"{path}: no finite pixel (all NaN or inf)")
+        out = img.copy()
+        out[bad] = np.median(img[~bad])
+        if self.filled == 0:
+            warnings.warn(
+                f"{path}: {int(bad.sum())} NaN or inf pixel(s) (dead or invalid) filled with "
+                "the image's median; later images with such pixels are only counted",
+                VideoWarning,
+                stacklevel=3,
+            )
+        self.filled += 1
+        return out
 
     # -------------------------------------------------------------- PyAV / OpenCV opening
     def _open_stream(self) -> Any:
