@@ -336,3 +336,22 @@ def test_a_change_to_another_aspect_ratio_stops_geo_referencing_with_exit_2(clip
     res = runner.invoke(app, ["track", str(video), "--out", str(tmp_path / "px")])
     assert res.exit_code == 0, res.output
     assert max(int(r["frame"]) for r in _rows(tmp_path / "px" / "tracks.csv")) >= 70
+
+
+def test_a_mask_over_the_ships_path_leaves_no_track(clip, tmp_path):
+    """--mask reaches the main job's detector (through the two-thread stream): with the
+    sea masked out below row 10 the medium ship is never boxed, so no track row; without
+    the mask it is tracked."""
+    import cv2
+
+    mask = np.zeros((540, 960), np.uint8)
+    mask[:10] = 255
+    cv2.imwrite(str(tmp_path / "mask.png"), mask)
+    video = str(clip / "video.mp4")
+    args = ["track", video, "--mask", str(tmp_path / "mask.png"), "--no-video", "--no-report"]
+    res = runner.invoke(app, [*args, "--out", str(tmp_path / "m"), "--json"])
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout[res.stdout.index("{") :])["rows"] == 0
+    res = runner.invoke(app, ["track", video, "--out", str(tmp_path / "all"), "--no-video",
+                              "--no-report", "--json"])  # fmt: skip
+    assert json.loads(res.stdout[res.stdout.index("{") :])["rows"] > 40

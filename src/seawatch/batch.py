@@ -126,8 +126,8 @@ def track_batch(
         scheduler: address of an existing Dask scheduler (``tcp://HOST:8786``).
         progress: ``progress(done, total)`` after each recording.
         detector_options: keywords of :func:`seawatch.vision.external.make_detector`
-            (``model``, ``threshold``, ``polarity``, ``temporal``); each recording gets a
-            detector of its own. None: the classical detector's defaults.
+            (``model``, ``threshold``, ``polarity``, ``temporal``, ``mask``); each
+            recording gets a detector of its own. None: the classical detector's defaults.
         options: further :func:`seawatch.pipeline.track_video` keywords (``estimator``,
             ``attitude``, ``annotate``, ``report``, …; files such as ``truth`` do not
             apply to a whole batch).
@@ -144,6 +144,9 @@ def track_batch(
     if not srcs:
         raise ValueError("SOURCES: expected at least one video, folder or stream")
     det_opts = dict(detector_options or {})
+    for key in ("model", "mask"):  # files are read on the workers: absolute paths
+        if det_opts.get(key) is not None:
+            det_opts[key] = str(Path(det_opts[key]).resolve())
     make_detector(**det_opts)  # bad options fail here, before any work
     if camera is not None and not Path(camera).is_file():
         raise ValueError(f"--camera {camera}: no such file")

@@ -168,6 +168,47 @@ def test_float_thermal_images_with_dead_pixels_are_detected_not_refused(tmp_path
         assert _matches(f["boxes"], truth), f["boxes"]
 
 
+def _with_overlay(tmp_path: Path) -> tuple[Path, list[np.ndarray]]:
+    """Two frames of :func:`scene` with a camera's text overlay burnt into the sea
+    (bright glyph strokes in rows 290–299, columns 20–139, as a time stamp)."""
+    folder = tmp_path / "osd"
+    folder.mkdir()
+    truths = []
+    for k in range(2):
+        img, boxes = scene(k, shift=4 * k)
+        for c in range(20, 140, 8):  # glyphs: 5 px strokes, 3 px gaps
+            img[290:300, c : c + 5] = 235
+        cv2.imwrite(str(folder / f"f{k}.png"), img)
+        truths.append(boxes)
+    return folder, truths
+
+
+def test_mask_keeps_the_ships_and_drops_the_text_overlay(tmp_path):
+    folder, truths = _with_overlay(tmp_path)
+    res = runner.invoke(app, [str(folder), "--json"])
+    assert res.exit_code == 0, res.output
+    for f in json.loads(res.stdout)["frames"]:  # the overlay is boxed without a mask
+        assert any(b["y"] > 280 and b["x"] < 140 for b in f["boxes"]), f["boxes"]
+    mask = np.full((320, 480), 255, np.uint8)
+    mask[285:305, 15:145] = 0
+    cv2.imwrite(str(tmp_path / "mask.png"), mask)
+    res = runner.invoke(app, [str(folder), "--json", "--mask", str(tmp_path / "mask.png")])
+    assert res.exit_code == 0, res.output
+    for f, truth in zip(json.loads(res.stdout)["frames"], truths, strict=True):
+        assert _matches(f["boxes"], truth), f["boxes"]
+    # a mask of half the frame's size is scaled; one of another aspect ratio is refused
+    cv2.imwrite(str(tmp_path / "half.png"), mask[::2, ::2])
+    res = runner.invoke(app, [str(folder), "--json", "--mask", str(tmp_path / "half.png")])
+    assert res.exit_code == 0, res.output
+    for f, truth in zip(json.loads(res.stdout)["frames"], truths, strict=True):
+        assert _matches(f["boxes"], truth), f["boxes"]
+    cv2.imwrite(str(tmp_path / "square.png"), mask[:, :320])
+    res = runner.invoke(app, [str(folder), "--mask", str(tmp_path / "square.png")])
+    assert res.exit_code == 2 and "--mask: 320x320, the frames are 480x320" in _msg(res)
+    res = runner.invoke(app, [str(folder), "--mask", str(tmp_path / "none.png")])
+    assert res.exit_code == 2 and "none.png" in _msg(res)
+
+
 def test_human_readable_output_has_one_line_per_frame(tmp_path):
     folder, _ = _folder(tmp_path, n=2)
     res = runner.invoke(app, [str(folder)])

@@ -31,7 +31,13 @@ from seawatch.vision.detect import (
     sea_region,
     waterline_points,
 )
-from seawatch.vision.external import CallableDetector, OnnxDetector, decode_yolo, make_detector
+from seawatch.vision.external import (
+    CallableDetector,
+    MaskedDetector,
+    OnnxDetector,
+    decode_yolo,
+    make_detector,
+)
 
 MARDCT = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "mardct_ir3"
 needs_mardct = pytest.mark.skipif(
@@ -901,6 +907,35 @@ def test_onnx_detector_needs_an_existing_model_and_says_how_to_get_onnxruntime(
     monkeypatch.setitem(sys.modules, "onnxruntime", None)  # as if not installed
     with pytest.raises(ImportError, match="pip install onnxruntime"):
         OnnxDetector(model)
+
+
+def test_masked_detector_keeps_the_boxes_whose_water_line_is_in_the_region(tmp_path):
+    """The six hulls of :func:`hull_scene`, a region of the right half only: the hulls
+    right of column 320 are kept, as the unmasked detector boxes them, by a direct call
+    and through prepare/detect_prepared (the tracker's two threads) alike."""
+    img, _, hz = hull_scene(1234, 0.8)
+    inner = ClassicalShipDetector()
+    region = np.zeros(img.shape[:2], np.uint8)
+    region[:, 320:] = 255
+    masked = MaskedDetector(inner, region)
+    full = inner(img, horizon=hz)
+    right = full.boxes[full.u_wl >= 320]
+    assert 0 < len(right) < len(full)
+    np.testing.assert_array_equal(masked(img, horizon=hz).boxes, right)
+    prepared = masked.prepare(img, horizon=hz)
+    np.testing.assert_array_equal(masked.detect_prepared(prepared).boxes, right)
+    cv2.imwrite(str(tmp_path / "region.png"), region[::2, ::2])  # half size: scaled
+    np.testing.assert_array_equal(MaskedDetector(inner, tmp_path / "region.png")(
+        img, horizon=hz).boxes, right)  # fmt: skip
+    with pytest.raises(ValueError, match="--mask: the region is empty"):
+        MaskedDetector(inner, np.zeros((10, 10)))
+    with pytest.raises(ValueError, match=r"--mask: expected an \(H, W\) image"):
+        MaskedDetector(inner, np.ones((4, 4, 3)))
+    (tmp_path / "junk.png").write_bytes(b"not a png")
+    with pytest.raises(ValueError, match="not a readable image"):
+        MaskedDetector(inner, tmp_path / "junk.png")
+    with pytest.raises(ValueError, match="--mask: 640x180, the frames are 640x360"):
+        MaskedDetector(inner, region[::2])(img, horizon=hz)
 
 
 def test_make_detector_builds_the_options_detector_or_names_the_bad_option(tmp_path, monkeypatch):

@@ -32,7 +32,13 @@ from seawatch.cli._common import (
     progress_bar,
     warnings_to_stderr,
 )
-from seawatch.cli.detect_cmds import ModelOption, PolarityOption, TemporalOption, ThresholdOption
+from seawatch.cli.detect_cmds import (
+    MaskOption,
+    ModelOption,
+    PolarityOption,
+    TemporalOption,
+    ThresholdOption,
+)
 
 app = typer.Typer(
     name="seawatch",
@@ -325,6 +331,7 @@ def batch(
     model: ModelOption = None,
     threshold: ThresholdOption = None,
     polarity: PolarityOption = "both",
+    mask: MaskOption = None,
     temporal: TemporalOption = False,
     workers: Annotated[
         int | None,
@@ -364,6 +371,7 @@ def batch(
                     "threshold": threshold,
                     "polarity": polarity,
                     "temporal": temporal,
+                    "mask": mask,
                 },
                 progress=lambda done, total: bar.update(task, completed=done, total=total),
             )

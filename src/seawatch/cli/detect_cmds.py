@@ -49,6 +49,7 @@ from seawatch.cli._common import (
 
 __all__ = [
     "CSV_COLUMNS",
+    "MaskOption",
     "ModelOption",
     "PolarityOption",
     "TemporalOption",
@@ -86,6 +87,14 @@ PolarityOption = Annotated[
         "sea: looking into the sun, where hulls are silhouettes and the bright boxes sun "
         "glitter) or bright (brighter than the sea); a hull of another colour than the "
         "sea is found by its chroma either way.",
+    ),
+]
+MaskOption = Annotated[
+    Path | None,
+    typer.Option(
+        "--mask",
+        help="Search region: an image of the frame's size, white where ships may be, black "
+        "where not (the own bow, a pier, the camera's text overlay).",
     ),
 ]
 TemporalOption = Annotated[
@@ -130,6 +139,7 @@ def detect(
     model: ModelOption = None,
     threshold: ThresholdOption = None,
     polarity: PolarityOption = "both",
+    mask: MaskOption = None,
     use_horizon: Annotated[
         bool,
         typer.Option(
@@ -159,7 +169,9 @@ def detect(
 
     with exit_codes(), warnings_to_stderr():
         check_span(start, end)
-        detector = make_detector(model, threshold=threshold, polarity=polarity, temporal=temporal)
+        detector = make_detector(
+            model, threshold=threshold, polarity=polarity, temporal=temporal, mask=mask
+        )
         reader = VideoReader(
             source, step=step, start=start, end=end, max_frames=max_frames, fps=fps
         )

@@ -22,6 +22,7 @@ from seawatch.cli._common import (
     warnings_to_stderr,
 )
 from seawatch.cli.detect_cmds import (
+    MaskOption,
     ModelOption,
     PolarityOption,
     TemporalOption,
@@ -131,6 +132,7 @@ def track(
     model: ModelOption = None,
     threshold: ThresholdOption = None,
     polarity: PolarityOption = "both",
+    mask: MaskOption = None,
     temporal: TemporalOption = False,
     pixel_sigma: Annotated[
         float, typer.Option(help="1-sigma of the water-line pixel [px].", min=0.01)
@@ -167,7 +169,9 @@ def track(
         if filter not in ("afkf", "fkf", "kf"):
             raise BadInput(f"--filter: expected afkf, fkf or kf, got {filter!r}")
         check_options(estimator, attitude)
-        detector = make_detector(model, threshold=threshold, polarity=polarity, temporal=temporal)
+        detector = make_detector(
+            model, threshold=threshold, polarity=polarity, temporal=temporal, mask=mask
+        )
         inputs = _load_inputs(camera, platform, ais, truth, start)
         live = "://" in source or source.isdigit() or source.startswith("/dev/")
         with progress_bar() as bar, _terminate_as_interrupt():

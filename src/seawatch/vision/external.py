@@ -8,8 +8,11 @@ protocol ``detector(image, *, sea_mask=None, horizon=None)`` and return
 * :class:`CallableDetector` — any user function that returns boxes;
 * :class:`OnnxDetector` — a YOLO-style ONNX model through onnxruntime (optional extra),
   its raw output decoded by :func:`decode_yolo`;
+* :class:`MaskedDetector` — any detector limited to a user's search region (a mask
+  image: not the own bow, a pier or the camera's text overlay);
 * :func:`make_detector` — the detector of the command line's detector options (an ONNX
-  model or the classical detector), for ``seawatch detect``, ``track`` and ``batch``.
+  model or the classical detector, optionally masked), for ``seawatch detect``,
+  ``track`` and ``batch``.
 
 Their boxes get the water-line point of :func:`seawatch.vision.detect.waterline_points`
 (the hull/sea edge inside the box) and are kept only on the sea, as the classical
@@ -32,7 +35,7 @@ from seawatch.vision.detect import Detections, _horizon_ends, _in_sea, _sea_mask
 from seawatch.vision.planes import _gray
 from seawatch.vision.waterline import waterline_points
 
-__all__ = ["CallableDetector", "OnnxDetector", "decode_yolo", "make_detector"]
+__all__ = ["CallableDetector", "MaskedDetector", "OnnxDetector", "decode_yolo", "make_detector"]
 
 
 def _in_sea_boxes(
@@ -394,6 +397,99 @@ class OnnxDetector:
 
 
 # --------------------------------------------------------------------------------------
+# a user's search region
+# --------------------------------------------------------------------------------------
+
+
+class MaskedDetector:
+    """A detector whose boxes are kept only where a user's search region allows.
+
+    ``region`` is an (H, W) array or an image file (PNG, …): non-zero where ships may
+    be, zero where not — the own boat's bow or rail, a pier, the camera's on-screen text
+    (a time stamp on the sea would be boxed in every frame). A box is kept when its
+    water-line point lies in the region (the detectors' own sea test, on the user's
+    mask). Frames of another size than the mask's but of its aspect ratio (within 1 %)
+    use the mask scaled to them (nearest pixel); another aspect ratio is a ValueError
+    naming ``--mask``. Forwards ``prepare``/``detect_prepared`` (the classical detector's
+    split across threads, :meth:`seawatch.vision.tracker.VisualTracker.stream`) and
+    ``reset``.
+    """
+
+    def __init__(self, detector: Any, region: ArrayLike | str | Path) -> None:
+        if not callable(detector):
+            raise ValueError(f"detector: expected a callable detector, got {detector!r}")
+        if isinstance(region, str | Path):
+            img = cv2.imread(str(region), cv2.IMREAD_GRAYSCALE)
+            if img is None:
+                raise ValueError(f"--mask {region}: not a readable image")
+            region = img
+        m = np.asarray(region)
+        if m.ndim != 2 or min(m.shape) < 1:
+            raise ValueError(f"--mask: expected an (H, W) image, got shape {m.shape}")
+        keep = m != 0
+        if not keep.any():
+            raise ValueError("--mask: the region is empty (every pixel is zero)")
+        self.detector = detector
+        self.region = keep
+        self._scaled: dict[tuple[int, int], NDArray[np.bool_]] = {}
+        if callable(getattr(detector, "prepare", None)) and callable(
+            getattr(detector, "detect_prepared", None)
+        ):
+            self.prepare = self._prepare
+            self.detect_prepared = self._detect_prepared
+
+    def reset(self) -> None:
+        """Reset the wrapped detector (when it has a ``reset``)."""
+        reset = getattr(self.detector, "reset", None)
+        if callable(reset):
+            reset()
+
+    def region_for(self, shape: tuple[int, int]) -> NDArray[np.bool_]:
+        """The region for frames of ``shape`` = (H, W) (the mask, or it scaled)."""
+        if shape == self.region.shape:
+            return self.region
+        got = self._scaled.get(shape)
+        if got is None:
+            (mh, mw), (h, w) = self.region.shape, shape
+            if abs((w / h) / (mw / mh) - 1.0) > 0.01:
+                raise ValueError(
+                    f"--mask: {mw}x{mh}, the frames are {w}x{h} (another aspect ratio)"
+                )
+            small = cv2.resize(self.region.astype(np.uint8), (w, h), cv2.INTER_NEAREST)
+            got = self._scaled[shape] = small != 0
+        return got
+
+    def _keep(self, det: Any, shape: tuple[int, int]) -> Detections:
+        det, _ = _as_detections(det, "detector's result")
+        if len(det) == 0:
+            return det
+        region = self.region_for(shape)
+        h, w = shape
+        u = np.clip(np.rint(det.u_wl), 0, w - 1).astype(np.intp)
+        v = np.clip(np.floor(det.v_wl - 0.5), 0, h - 1).astype(np.intp)  # the pixel above
+        return Detections(det.boxes[region[v, u]])
+
+    def __call__(
+        self, image: ArrayLike, *, sea_mask: ArrayLike | None = None, horizon: Any = None
+    ) -> Detections:
+        """Detect with the wrapped detector and keep the boxes in the region."""
+        shape = np.shape(image)[:2]
+        try:
+            det = self.detector(image, sea_mask=sea_mask, horizon=horizon)
+        except TypeError:
+            det = self.detector(image)
+        return self._keep(det, (int(shape[0]), int(shape[1])))
+
+    def _prepare(self, image: ArrayLike, **kw: Any) -> tuple[Any, tuple[int, int]]:
+        shape = np.shape(image)[:2]
+        return self.detector.prepare(image, **kw), (int(shape[0]), int(shape[1]))
+
+    def _detect_prepared(self, prepared: tuple[Any, tuple[int, int]]) -> Detections:
+        inner, shape = prepared
+        return self._keep(self.detector.detect_prepared(inner), shape)
+
+
+# --------------------------------------------------------------------------------------
 # the command line's detector options
 # --------------------------------------------------------------------------------------
 
@@ -404,6 +500,7 @@ def make_detector(
     threshold: float | None = None,
     polarity: str = "both",
     temporal: bool = False,
+    mask: str | Path | None = None,
 ) -> Any:
     """The ship detector of the detector options of ``seawatch detect``/``track``/``batch``.
 
@@ -420,15 +517,22 @@ def make_detector(
             ``both`` with more false boxes, 25 against 13 in 88 frames: the arbitration
             between the polarities also removes clutter.)
         temporal: the classical detector's temporal clutter model.
+        mask: an image file of the search region (:class:`MaskedDetector`), or None.
 
     Raises:
-        ValueError: naming the option (``--model``, ``--threshold``, ``--polarity``) for a
-            missing model file, a missing onnxruntime or a bad value.
+        ValueError: naming the option (``--model``, ``--threshold``, ``--polarity``,
+            ``--mask``) for a missing model or mask file, a missing onnxruntime or a bad
+            value.
     """
     from seawatch.vision.detect import ClassicalShipDetector
 
     if polarity not in ("both", "dark", "bright"):
         raise ValueError(f"--polarity: expected both, dark or bright, got {polarity!r}")
+    if mask is not None:
+        inner = make_detector(model, threshold=threshold, polarity=polarity, temporal=temporal)
+        if not Path(mask).is_file():
+            raise ValueError(f"--mask {mask}: no such image file")
+        return MaskedDetector(inner, mask)
     if model is not None:
         path = Path(model)
         if not path.is_file():
