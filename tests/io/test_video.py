@@ -262,6 +262,37 @@ def test_size_change_and_timestamp_restart_mid_stream_warn_and_keep_all_frames(t
     np.testing.assert_allclose([f.time for f in frames], np.arange(20) / FPS, atol=1e-6)
 
 
+@pytest.mark.parametrize(("rotation", "k"), [(-90, -1), (90, 1), (180, 2)])
+def test_a_display_rotation_is_applied_as_players_do(tmp_path: Path, rotation: int, k: int):
+    """A phone stores a portrait video as landscape pixels plus a display matrix (FFmpeg's
+    rotation, degrees counter-clockwise); players turn the frames, decoders do not. The
+    reader turns them the same way (np.rot90 by rotation / 90), once reported, and the
+    size it announces is then the upright one; the pixels are the stored frame's."""
+    path = tmp_path / f"r{rotation}.mp4"
+    stored = np.zeros((64, 96, 3), np.uint8)
+    stored[:20] = 255  # a bright band along the stored top edge
+    stored[:, :12] = 128  # a grey one along the stored left edge
+    with av.open(str(path), "w") as c:
+        s = c.add_stream("libx264", rate=25)
+        s.width, s.height, s.pix_fmt = 96, 64, "yuv420p"
+        s.options = {"crf": "0"}
+        s.set_display_rotation(rotation)
+        for _ in range(3):
+            for p in s.encode(av.VideoFrame.from_ndarray(stored, format="bgr24")):
+                c.mux(p)
+        for p in s.encode():
+            c.mux(p)
+    reader = VideoReader(path)
+    with pytest.warns(VideoWarning, match="turned upright") as record:
+        frames = list(reader)
+    assert len(frames) == 3 and len([w for w in record if "upright" in str(w.message)]) == 1
+    want = np.rot90(stored, k=k)
+    for f in frames:
+        assert f.image.shape == want.shape
+        assert np.abs(f.image.astype(int) - want).mean() < 3.0  # lossless but for YUV
+    assert reader.size == (want.shape[1], want.shape[0])
+
+
 @pytest.mark.parametrize("content", [b"", b"not a video at all " * 50])
 def test_undecodable_file_is_a_video_error_naming_it(tmp_path: Path, content: bytes):
     path = tmp_path / "junk.mp4"

@@ -304,6 +304,7 @@ class VideoReader:
         self._files: list[Path] = []
         self._handle: Any = None  # an opened container/capture, for the first iteration
         self._size: tuple[int, int] | None = None
+        self._rotation_noted = False
         self._rate: float | None = None
         self._count: int | None = None
         if self.kind in ("folder", "image"):
@@ -319,7 +320,8 @@ class VideoReader:
 
     @property
     def size(self) -> tuple[int, int] | None:
-        """(width, height) [px] announced by the source (first image of a folder), or None."""
+        """(width, height) [px] announced by the source (first image of a folder), or None;
+        upright once the first frame has shown a display rotation of 90° or 270°."""
         return self._size
 
     @property
@@ -546,12 +548,45 @@ class VideoReader:
         name = frame.format.name
         if name.startswith(("gray", "ya")) or name in ("monob", "monow"):
             deep = any(d in name for d in ("9", "10", "12", "14", "16", "32"))
-            if deep:
-                return frame.to_ndarray(format="gray16le")
-            return frame.to_ndarray(format="gray")
-        if self.gray:
-            return frame.to_ndarray(format="gray")
-        return frame.to_ndarray(format="bgr24")
+            img = frame.to_ndarray(format="gray16le" if deep else "gray")
+        elif self.gray:
+            img = frame.to_ndarray(format="gray")
+        else:
+            img = frame.to_ndarray(format="bgr24")
+        return self._upright(img, getattr(frame, "rotation", 0))
+
+    def _upright(self, img: NDArray[Any], rotation: float) -> NDArray[Any]:
+        """The frame as it is meant to be shown: a phone's portrait video is stored as
+        landscape pixels with a display matrix (``rotation``, degrees counter-clockwise,
+        FFmpeg's convention) that players apply and decoders do not; turned here by
+        that multiple of 90° (reported once). Other angles are left alone (warned)."""
+        if not rotation:
+            return img
+        quarter = round(rotation / 90.0)
+        if abs(rotation - 90.0 * quarter) > 1e-6:
+            if not self._rotation_noted:
+                self._rotation_noted = True
+                warnings.warn(
+                    f"{self._describe()}: display rotation of {rotation:g} degrees is not a "
+                    "multiple of 90: frames left as stored",
+                    VideoWarning,
+                    stacklevel=4,
+                )
+            return img
+        if quarter % 4 == 0:
+            return img
+        img = np.ascontiguousarray(np.rot90(img, k=quarter % 4))
+        if not self._rotation_noted:
+            self._rotation_noted = True
+            self._size = (int(img.shape[1]), int(img.shape[0]))
+            turn = {1: "90 degrees counter-clockwise", 2: "180 degrees", 3: "90 degrees clockwise"}
+            warnings.warn(
+                f"{self._describe()}: frames turned upright ({turn[quarter % 4]}), as the "
+                "file's display matrix asks (e.g. a phone's portrait video)",
+                VideoWarning,
+                stacklevel=4,
+            )
+        return img
 
     def _decoded(self, container: Any, log: _Log, state: dict[str, int]) -> Iterator[Any]:
         """Decoded PyAV frames; corrupt packets skipped and counted, a failing demux ends."""
