@@ -41,7 +41,7 @@ from seawatch.metrics.cle import CLEResult, centre_location_error
 from seawatch.scenarios.base import ExperimentResult, ProgressCallback, record
 from seawatch.synth import render_case
 from seawatch.synth.cases import CASES
-from seawatch.vision.tracker import FILTERS, VisualTracker, tracks_to_rows
+from seawatch.vision.tracker import DEFAULT_ORDER, FILTERS, VisualTracker, tracks_to_rows
 
 __all__ = ["ORDERS", "chunk", "merge", "plot_cle", "run", "track_case", "unit_costs", "units"]
 
@@ -380,7 +380,9 @@ def plot_cle(done: Sequence[dict[str, Any]], path: str | Path) -> Path:
             ax.plot(np.full(len(sweep[a]), a), sweep[a], "o", color="#d62728", ms=3, alpha=0.6)
         ax.plot(orders, [np.nanmean(sweep[a]) for a in orders], "-", color="#d62728",
                 label="afkf, mean")  # fmt: skip
-        ax.axvline(0.95, color="black", lw=0.8, ls=":", label="default order 0.95")
+        ax.axvline(
+            DEFAULT_ORDER, color="black", lw=0.8, ls=":", label=f"default order {DEFAULT_ORDER:g}"
+        )
         ax.legend(fontsize=8)
     else:
         ax.text(0.5, 0.5, "no order sweep (small case not run)", ha="center",

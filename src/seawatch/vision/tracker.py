@@ -43,7 +43,7 @@ from seawatch.filters import (
 from seawatch.tracking.mtt import MultiTargetTracker, TrackStates
 from seawatch.vision.detect import ClassicalShipDetector, Detections
 
-__all__ = ["FILTERS", "TRACK_COLUMNS", "VisualTracker", "tracks_to_rows"]
+__all__ = ["DEFAULT_ORDER", "FILTERS", "TRACK_COLUMNS", "VisualTracker", "tracks_to_rows"]
 
 TRACK_COLUMNS: tuple[str, ...] = ("id", "x", "y", "w", "h", "u_wl", "v_wl", "misses")
 """Columns of a per-frame track array: track id, box top-left x, y [px], width w and
@@ -56,6 +56,9 @@ READ_THREAD = "seawatch-read"
 prepares each frame."""
 DETECT_THREAD = "seawatch-detect"
 """Name of :meth:`VisualTracker.stream`'s thread that detects the ships."""
+
+DEFAULT_ORDER = 0.95
+"""Default fractional order alpha of the AFKF/FKF (ALGORITHMS.md §1.3: tunable 0.8–1.0)."""
 
 FilterName = Literal["afkf", "fkf", "kf"]
 FILTERS: tuple[str, ...] = ("afkf", "fkf", "kf")
@@ -94,7 +97,8 @@ class VisualTracker:
         detector: a detector ``detector(image, horizon=...) -> Detections`` (or boxes);
             None: :class:`ClassicalShipDetector` with its defaults.
         filter: ``"afkf"``, ``"fkf"`` or ``"kf"`` (module docstring).
-        order: fractional order alpha of afkf/fkf (ALGORITHMS.md §1.3; default 0.95).
+        order: fractional order alpha of afkf/fkf (ALGORITHMS.md §1.3;
+            :data:`DEFAULT_ORDER`).
         memory: GL history length L of afkf/fkf (default 30).
         sigma_a: acceleration noise of the box centre [px/frame²] (Q0, §1.3).
         sigma_z: box-centre jitter of the detector [px] (R = σ_z² I).
@@ -139,7 +143,7 @@ class VisualTracker:
         self,
         detector: Any = None,
         filter: FilterName = "afkf",
-        order: float = 0.95,
+        order: float = DEFAULT_ORDER,
         memory: int = 30,
         *,
         sigma_a: float = 0.5,
