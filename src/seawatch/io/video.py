@@ -17,9 +17,12 @@ Images
 ``image`` is a numpy array in OpenCV's conventions: (H, W, 3) **BGR** for colour, (H, W)
 for grayscale; ``uint8`` for 8-bit sources, ``uint16`` for 16-bit ones (e.g. 16-bit
 thermal PNG/TIFF, ``gray16le`` video), ``float32`` for floating-point TIFFs (values as
-stored). An alpha channel is dropped (RGBA → BGR). With ``gray=True`` every frame is
-converted to one channel (luma, ITU-R BT.601), which for video is the decoder's Y plane
-and the cheapest way to feed a grayscale pipeline.
+stored; NaN or inf pixels — a radiometric camera's dead ones — filled with the image's
+median, see :attr:`VideoReader.filled`). An alpha channel is dropped (RGBA → BGR). A
+video with a display rotation (a phone's portrait video) is turned upright, as players
+do. With ``gray=True`` every frame is converted to one channel (luma, ITU-R BT.601),
+which for video is the decoder's Y plane and the cheapest way to feed a grayscale
+pipeline.
 
 Time
 ----
