@@ -59,6 +59,8 @@ results: $(VENV)/.installed-test
 	$(BIN)/seawatch experiment ship-video --seed 0 --out $(R)/ship-video
 	$(BIN)/seawatch experiment ship-video --seed 0 --crf 0 --out $(R)/ship-video-crf0
 	$(BIN)/seawatch experiment ship-video --runs 3 --seed 0 --out $(R)/ship-video-runs3
+	$(BIN)/seawatch experiment ship-video --case lighting --polarity dark --runs 3 --seed 0 \
+		--out $(R)/ship-video-lighting-dark
 	$(BIN)/seawatch experiment stereo-ferry --runs 1000 --seed 0 --out $(R)/stereo-ferry
 	$(BIN)/seawatch experiment stereo-ferry --runs 1000 --seed 0 --variant stereo-prior \
 		--out $(R)/stereo-ferry/stereo-prior

@@ -153,6 +153,19 @@ def experiment(
             "(default 20).",
         ),
     ] = None,
+    case: Annotated[
+        list[str] | None,
+        typer.Option(
+            help="ship-video: run this case only (repeatable; default every case).",
+        ),
+    ] = None,
+    polarity: Annotated[
+        str | None,
+        typer.Option(
+            help="ship-video: ships the detector looks for, both (default), dark (a camera "
+            "facing the sun) or bright.",
+        ),
+    ] = None,
     workers: Annotated[
         int | None,
         typer.Option(help="Dask worker processes (default: the machine's cores).", min=1),
@@ -192,13 +205,15 @@ def experiment(
             "camera_heading": camera_heading,
             "fov": fov,
             "crf": crf,
+            "cases": case or None,
+            "polarity": polarity,
         }
         accepted = registry.options(name)
         for key, value in scenario_options.items():
             if value is None:
                 continue
             if key not in accepted:
-                flag = "--" + key.replace("_", "-")
+                flag = "--" + ("case" if key == "cases" else key.replace("_", "-"))
                 raise BadInput(f"{flag}: experiment {name!r} does not take this option")
             kwargs[key] = value
         with progress_bar() as bar:

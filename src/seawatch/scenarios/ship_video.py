@@ -41,6 +41,7 @@ from seawatch.metrics.cle import CLEResult, centre_location_error
 from seawatch.scenarios.base import ExperimentResult, ProgressCallback, record
 from seawatch.synth import render_case
 from seawatch.synth.cases import CASES
+from seawatch.vision.detect import ClassicalShipDetector
 from seawatch.vision.tracker import DEFAULT_ORDER, FILTERS, VisualTracker, tracks_to_rows
 
 __all__ = ["ORDERS", "chunk", "merge", "plot_cle", "run", "track_case", "unit_costs", "units"]
@@ -126,8 +127,11 @@ def _unit_options(
     small_scale: int,
     fps: float,
     crf: int,
+    polarity: str,
 ) -> dict[str, Any]:
-    """The rendering and sweep options of :func:`_unit`, checked."""
+    """The rendering, detection and sweep options of :func:`_unit`, checked."""
+    if polarity not in ("both", "dark", "bright"):
+        raise ValueError(f"polarity: expected both, dark or bright, got {polarity!r}")
     return {
         "width": width,
         "height": height,
@@ -136,6 +140,7 @@ def _unit_options(
         "small_scale": small_scale,
         "fps": fps,
         "crf": integer("crf", crf, 0, 51),  # libx264's range
+        "polarity": polarity,
     }
 
 
@@ -157,6 +162,7 @@ def _unit(
     small_scale: int,
     fps: float,
     crf: int,
+    polarity: str,
 ) -> dict[str, Any]:
     """Render (into ``folder``), detect and track unit ``u`` (:func:`_case`); rows
     ``(estimator, order, cle_px, cle_percent, precision)`` with order None except in the
@@ -173,7 +179,8 @@ def _unit(
         seed=seed + r,
         crf=crf,
     )
-    dets = detect_video(res.video, VisualTracker(fps=fps))
+    detector = ClassicalShipDetector(polarity=polarity)  # type: ignore[arg-type]
+    dets = detect_video(res.video, VisualTracker(detector=detector, fps=fps))
     truth = read_truth(res.truth)
     rows: list[tuple[str, float | None, float, float, float]] = []
     for est in FILTERS:
@@ -183,7 +190,7 @@ def _unit(
         for a in orders:
             c = track_case(dets, truth, "afkf", order=a)
             rows.append(("afkf", a, c.mean_px, c.mean_percent, c.precision))
-    return {"run": r, "case": name, "crf": crf, "rows": rows}
+    return {"run": r, "case": name, "crf": crf, "polarity": polarity, "rows": rows}
 
 
 _HEADER = ["case", "run", "estimator", "order", "cle_px", "cle_percent", "precision"]
@@ -210,6 +217,7 @@ def run(
     small_scale: int = 2,
     fps: float = 25.0,
     crf: int = 20,
+    polarity: str = "both",
 ) -> ExperimentResult:
     """Run the ship-video experiment (module docstring).
 
@@ -227,6 +235,8 @@ def run(
         crf: libx264 quality of the rendered footage (0–51; default 20, as the
             ``seawatch synth`` clips; 0 is lossless, which isolates the error of the
             detector and tracker from the compression's).
+        polarity: ships the classical detector looks for (``both``; ``dark`` for a camera
+            facing the sun, :func:`seawatch.vision.external.make_detector`).
 
     Returns:
         :class:`ExperimentResult` with records ``cle_px``, ``cle_percent``,
@@ -236,7 +246,7 @@ def run(
     """
     n_runs = integer("runs", runs, 1)
     names = _names(cases)
-    opts = _unit_options(width, height, duration, orders, small_scale, fps, crf)
+    opts = _unit_options(width, height, duration, orders, small_scale, fps, crf, polarity)
     with contextlib.ExitStack() as stack:
         if out_dir is None:
             root = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="seawatch-sv-")))
@@ -278,12 +288,13 @@ def chunk(
     small_scale: int = 2,
     fps: float = 25.0,
     crf: int = 20,
+    polarity: str = "both",
 ) -> list[dict[str, Any]]:
     """Units ``indices`` (run × case, see :func:`units`) of the experiment, rendered in a
     temporary folder (the parallel protocol of :mod:`seawatch.scenarios.parallel`); a
     unit's numbers depend only on (seed, run, case)."""
     names = _names(cases)
-    opts = _unit_options(width, height, duration, orders, small_scale, fps, crf)
+    opts = _unit_options(width, height, duration, orders, small_scale, fps, crf, polarity)
     idx = [int(i) for i in indices]
     n = integer("runs", runs, 1) * len(names)
     if not idx or idx != sorted(set(idx)) or idx[0] < 0 or idx[-1] >= n:
@@ -412,7 +423,11 @@ def _result(
     for name in names:
         m = [float(np.nanmean(values[(e, "cle_percent", name)])) for e in FILTERS]
         ordering[name] = bool(m[0] <= m[1] <= m[2])
-    extra: dict[str, Any] = {"ordering": ordering, "crf": done[0]["crf"] if done else None}
+    extra: dict[str, Any] = {
+        "ordering": ordering,
+        "crf": done[0]["crf"] if done else None,
+        "polarity": done[0].get("polarity", "both") if done else None,
+    }
     swept = {a: float(np.nanmean(v)) for a, v in sweep.items() if v}
     if swept and all(np.isfinite(list(swept.values()))):
         best = min(swept, key=lambda a: swept[a])
