@@ -102,6 +102,10 @@ def test_experiment_json_has_the_interfaces_shape(tmp_path):
         ["experiment", "air-range", "--fov", "30"],
         ["experiment", "air-range", "--crf", "0"],
         ["experiment", "ship-video", "--crf", "60"],
+        ["experiment", "air-range", "--case", "small"],
+        ["experiment", "air-range", "--polarity", "dark"],
+        ["experiment", "ship-video", "--case", "tiny"],
+        ["experiment", "ship-video", "--case", "small", "--polarity", "grey"],
     ],
 )
 def test_experiment_bad_name_or_option_is_exit_2(args):
