@@ -95,7 +95,8 @@ def horizon_run(clip, tmp_path_factory):
     # the case's mast sways: the horizon gives each frame's pitch and roll
     out = tmp_path_factory.mktemp("horizon-run")
     cam = load_camera(clip / "camera.yaml")
-    return track_video(clip / "video.mp4", out, camera=cam, attitude="horizon"), out
+    run = track_video(clip / "video.mp4", out, camera=cam, attitude="horizon", parquet=True)
+    return run, out
 
 
 def _late_errors(clip: Path, rows: list[dict]) -> tuple[list[dict], list[float], float]:
@@ -123,9 +124,15 @@ def test_outputs_are_consistent_with_each_other(clip, horizon_run):
         "tracks.geojson",
         "annotated.mp4",
         "report.html",
+        "tracks.parquet",
     } <= names
     rows = _rows(tmp_path / "tracks.csv")
     assert list(rows[0]) == list(TRACK_TABLE_COLUMNS)
+    import pyarrow.parquet as pq  # the Parquet copy: the same table
+
+    table = pq.read_table(tmp_path / "tracks.parquet")
+    assert table.column_names == list(TRACK_TABLE_COLUMNS) and table.num_rows == len(rows)
+    assert table.column("north_m").to_pylist() == [float(r["north_m"]) for r in rows]
     est = _rows(tmp_path / "estimates.csv")
     # tracks.csv holds the EKF's estimate, estimates.csv every estimator's for each row
     assert len(est) == 4 * len(rows)
