@@ -463,11 +463,7 @@ class MaskedDetector:
         det, _ = _as_detections(det, "detector's result")
         if len(det) == 0:
             return det
-        region = self.region_for(shape)
-        h, w = shape
-        u = np.clip(np.rint(det.u_wl), 0, w - 1).astype(np.intp)
-        v = np.clip(np.floor(det.v_wl - 0.5), 0, h - 1).astype(np.intp)  # the pixel above
-        return Detections(det.boxes[region[v, u]])
+        return _in_sea_boxes(det, shape, self.region_for(shape), None, 0.0)
 
     def __call__(
         self, image: ArrayLike, *, sea_mask: ArrayLike | None = None, horizon: Any = None
