@@ -177,3 +177,15 @@ def int_pair(name: str, value: object, labels: tuple[str, str], minimum: int) ->
 
 def _fmt(shape: tuple[int | None, ...]) -> str:
     return "(" + ", ".join("any" if s is None else str(s) for s in shape) + ")"
+
+
+ASPECT_TOLERANCE = 0.01
+"""Frame sizes whose aspect ratios agree within this fraction show the same view at
+another resolution: a camera file's intrinsics (:func:`seawatch.pipeline.track_video`)
+and a search mask (:class:`seawatch.vision.external.MaskedDetector`) are scaled to them."""
+
+
+def same_aspect(size: tuple[int, int], other: tuple[int, int]) -> bool:
+    """Whether the (width, height) sizes ``size`` and ``other`` [px] have one aspect ratio,
+    within :data:`ASPECT_TOLERANCE`."""
+    return abs((size[0] / size[1]) / (other[0] / other[1]) - 1.0) <= ASPECT_TOLERANCE

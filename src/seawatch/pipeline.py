@@ -51,6 +51,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from seawatch._validation import same_aspect
 from seawatch.camera.horizon import attitude_from_horizon
 from seawatch.camera.pinhole import PinholeCamera
 from seawatch.geometry.geodesy import north_east_to_geodetic
@@ -102,10 +103,6 @@ estimator (long form)."""
 
 PIXEL_SIGMA = 1.0
 """Default 1-σ of the water-line pixel [px] (detector jitter plus quantisation)."""
-
-ASPECT_TOLERANCE = 0.01
-"""Frames whose aspect ratio is within this fraction of the camera file's are the same
-view at another resolution: the intrinsics are scaled to them (:func:`_camera_for`)."""
 
 COAST_SECONDS = 3.0
 """How long a confirmed track survives without detections, by prediction [s] (at least
@@ -389,13 +386,13 @@ def check_options(estimator: str, attitude: str) -> None:
 def _camera_for(camera: PinholeCamera, size: tuple[int, int], where: str) -> PinholeCamera:
     """The camera for frames of ``size`` = (width, height) [px]: the camera itself, or
     its :meth:`~seawatch.camera.PinholeCamera.resized` copy for the same view at another
-    resolution (aspect ratios within 1 %). ValueError naming ``--camera`` and ``where``
-    for another aspect ratio: a crop or another camera, whose pixels cannot be told
-    apart from the calibrated ones' by their size alone."""
+    resolution (:func:`~seawatch._validation.same_aspect`). ValueError naming
+    ``--camera`` and ``where`` for another aspect ratio: a crop or another camera, whose
+    pixels cannot be told apart from the calibrated ones' by their size alone."""
     if size == camera.image_size:
         return camera
     (cw, ch), (w, h) = camera.image_size, size
-    if abs((w / h) / (cw / ch) - 1.0) > ASPECT_TOLERANCE:
+    if not same_aspect(size, camera.image_size):
         raise ValueError(
             f"--camera: calibrated for {cw}x{ch} frames, {where} is {w}x{h} (another aspect "
             "ratio: a crop or another camera); calibrate the camera for this stream"

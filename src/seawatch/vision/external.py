@@ -30,7 +30,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from seawatch._validation import FloatArray, in_range, int_pair
+from seawatch._validation import FloatArray, in_range, int_pair, same_aspect
 from seawatch.vision.detect import Detections, _horizon_ends, _in_sea, _sea_mask
 from seawatch.vision.planes import _gray
 from seawatch.vision.waterline import waterline_points
@@ -408,11 +408,11 @@ class MaskedDetector:
     be, zero where not — the own boat's bow or rail, a pier, the camera's on-screen text
     (a time stamp on the sea would be boxed in every frame). A box is kept when its
     water-line point lies in the region (the detectors' own sea test, on the user's
-    mask). Frames of another size than the mask's but of its aspect ratio (within 1 %)
-    use the mask scaled to them (nearest pixel); another aspect ratio is a ValueError
-    naming ``--mask``. Forwards ``prepare``/``detect_prepared`` (the classical detector's
-    split across threads, :meth:`seawatch.vision.tracker.VisualTracker.stream`) and
-    ``reset``.
+    mask). Frames of another size than the mask's but of its aspect ratio
+    (:func:`~seawatch._validation.same_aspect`) use the mask scaled to them (nearest
+    pixel); another aspect ratio is a ValueError naming ``--mask``. Forwards
+    ``prepare``/``detect_prepared`` (the classical detector's split across threads,
+    :meth:`seawatch.vision.tracker.VisualTracker.stream`) and ``reset``.
     """
 
     def __init__(self, detector: Any, region: ArrayLike | str | Path) -> None:
@@ -451,7 +451,7 @@ class MaskedDetector:
         got = self._scaled.get(shape)
         if got is None:
             (mh, mw), (h, w) = self.region.shape, shape
-            if abs((w / h) / (mw / mh) - 1.0) > 0.01:
+            if not same_aspect((w, h), (mw, mh)):
                 raise ValueError(
                     f"--mask: {mw}x{mh}, the frames are {w}x{h} (another aspect ratio)"
                 )
