@@ -41,7 +41,7 @@ from seawatch.metrics.cle import CLEResult, centre_location_error
 from seawatch.scenarios.base import ExperimentResult, ProgressCallback, record
 from seawatch.synth import render_case
 from seawatch.synth.cases import CASES
-from seawatch.vision.detect import ClassicalShipDetector
+from seawatch.vision.detect import POLARITIES, ClassicalShipDetector
 from seawatch.vision.tracker import DEFAULT_ORDER, FILTERS, VisualTracker, tracks_to_rows
 
 __all__ = ["ORDERS", "chunk", "merge", "plot_cle", "run", "track_case", "unit_costs", "units"]
@@ -130,7 +130,7 @@ def _unit_options(
     polarity: str,
 ) -> dict[str, Any]:
     """The rendering, detection and sweep options of :func:`_unit`, checked."""
-    if polarity not in ("both", "dark", "bright"):
+    if polarity not in POLARITIES:
         raise ValueError(f"polarity: expected both, dark or bright, got {polarity!r}")
     return {
         "width": width,

@@ -46,6 +46,7 @@ from seawatch.vision.waterline import _frame_ships, _waterline, waterline_points
 
 __all__ = [
     "DETECTION_COLUMNS",
+    "POLARITIES",
     "ClassicalShipDetector",
     "Detections",
     "Detector",
@@ -59,6 +60,8 @@ DETECTION_COLUMNS = ("x", "y", "w", "h", "score", "u_wl", "v_wl")
 h [px], score [0, 1], water-line point u_wl, v_wl [px]."""
 
 Polarity = Literal["both", "bright", "dark"]
+POLARITIES: tuple[str, ...] = ("both", "bright", "dark")
+"""The ships :class:`ClassicalShipDetector` looks for (``polarity``)."""
 
 
 # --------------------------------------------------------------------------------------
@@ -846,7 +849,7 @@ class ClassicalShipDetector:
             raise ValueError(
                 f"grow_threshold: expected <= threshold ({threshold}), got {grow_threshold}"
             )
-        if polarity not in ("both", "bright", "dark"):
+        if polarity not in POLARITIES:
             raise ValueError(f"polarity: expected 'both', 'bright' or 'dark', got {polarity!r}")
         self.polarity: Polarity = polarity
         self.work_height = integer("work_height", work_height, 16)

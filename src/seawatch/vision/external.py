@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from seawatch._validation import FloatArray, in_range, int_pair, same_aspect
-from seawatch.vision.detect import Detections, _horizon_ends, _in_sea, _sea_mask
+from seawatch.vision.detect import POLARITIES, Detections, _horizon_ends, _in_sea, _sea_mask
 from seawatch.vision.planes import _gray
 from seawatch.vision.waterline import waterline_points
 
@@ -522,7 +522,7 @@ def make_detector(
     """
     from seawatch.vision.detect import ClassicalShipDetector
 
-    if polarity not in ("both", "dark", "bright"):
+    if polarity not in POLARITIES:
         raise ValueError(f"--polarity: expected both, dark or bright, got {polarity!r}")
     if mask is not None:
         inner = make_detector(model, threshold=threshold, polarity=polarity, temporal=temporal)
