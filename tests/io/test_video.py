@@ -4,9 +4,6 @@ known effects, and every bad-input path of issue 6 ("Video in", "Bad input")."""
 
 from __future__ import annotations
 
-import http.server
-import socketserver
-import threading
 import warnings
 from collections.abc import Iterator
 from fractions import Fraction
@@ -328,6 +325,8 @@ def test_unreachable_stream_url_is_a_video_error():
         ({"max_frames": 0}, "max_frames"),
         ({"fps": 0.0}, "fps"),
         ({"backend": "gstreamer"}, "backend"),
+        ({"reconnect": -1}, "reconnect"),
+        ({"reconnect_wait": -1.0}, "reconnect_wait"),
     ],
 )
 def test_bad_reader_options_are_value_errors_naming_them(clip: Path, kwargs: dict, name: str):
@@ -336,40 +335,6 @@ def test_bad_reader_options_are_value_errors_naming_them(clip: Path, kwargs: dic
 
 
 # ----------------------------------------------------------------------------- streams
-class _Server:
-    """A local HTTP server sending a file whole or cut off after half (a dropped stream)."""
-
-    def __init__(self, data: bytes) -> None:
-        payload = data
-
-        class Handler(http.server.BaseHTTPRequestHandler):
-            def do_GET(self) -> None:
-                drop = self.path.startswith("/drop")
-                self.send_response(200)
-                self.send_header("Content-Type", "video/mp2t")
-                self.send_header("Content-Length", str(len(payload)))
-                self.end_headers()
-                self.wfile.write(payload[: len(payload) // 2] if drop else payload)
-                self.wfile.flush()
-                if drop:
-                    self.connection.close()
-
-            def log_message(self, *args: object) -> None:
-                pass
-
-        self.httpd = socketserver.TCPServer(("127.0.0.1", 0), Handler)
-        self.port = self.httpd.server_address[1]
-        self.thread = threading.Thread(target=self.httpd.serve_forever, daemon=True)
-
-    def __enter__(self) -> _Server:
-        self.thread.start()
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.httpd.shutdown()
-        self.httpd.server_close()
-
-
 @pytest.fixture(scope="module")
 def transport_stream(tmp_path_factory: pytest.TempPathFactory) -> Iterator[bytes]:
     path = tmp_path_factory.mktemp("ts") / "stream.ts"
@@ -379,8 +344,10 @@ def transport_stream(tmp_path_factory: pytest.TempPathFactory) -> Iterator[bytes
     yield path.read_bytes()
 
 
-def test_http_stream_is_read_live_with_times_from_zero(transport_stream: bytes):
-    with _Server(transport_stream) as server:
+def test_http_stream_is_read_live_with_times_from_zero(
+    transport_stream: bytes, stream_server: type
+):
+    with stream_server(transport_stream) as server:
         reader = VideoReader(f"http://127.0.0.1:{server.port}/live.ts", timeout=5.0)
         assert reader.kind == "url" and reader.live
         frames = _frames(reader)
@@ -388,8 +355,10 @@ def test_http_stream_is_read_live_with_times_from_zero(transport_stream: bytes):
     np.testing.assert_allclose([f.time for f in frames], np.arange(N) / FPS, atol=1e-6)
 
 
-def test_a_stream_that_drops_ends_with_a_warning_and_keeps_the_frames(transport_stream: bytes):
-    with _Server(transport_stream) as server:
+def test_a_stream_that_drops_ends_with_a_warning_and_keeps_the_frames(
+    transport_stream: bytes, stream_server: type
+):
+    with stream_server(transport_stream) as server:
         reader = VideoReader(f"http://127.0.0.1:{server.port}/drop.ts", timeout=5.0)
         with pytest.warns(VideoWarning, match="stream ended"):
             frames = list(reader)
@@ -399,6 +368,77 @@ def test_a_stream_that_drops_ends_with_a_warning_and_keeps_the_frames(transport_
     idx = [f.index for f in frames]
     assert idx[0] == 0 and bool(np.all(np.diff(idx) > 0))
     assert idx[-1] < N
+
+
+def test_a_dropped_live_stream_is_reconnected_and_time_and_indices_go_on(
+    transport_stream: bytes, stream_server: type
+):
+    with stream_server(transport_stream, plan=("half", "whole")) as server:
+        reader = VideoReader(
+            f"http://127.0.0.1:{server.port}/plan.ts",
+            timeout=5.0,
+            reconnect=2,
+            reconnect_wait=0.0,
+            backend="pyav",  # one request per attempt ("auto" tries OpenCV after PyAV)
+        )
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            frames = list(reader)
+        requests = server.requests
+    said = " | ".join(str(w.message) for w in caught)
+    # the first connection cut off, the second whole, then two refused attempts
+    assert requests == 4
+    assert reader.reconnects == 1 and reader.lost_seconds >= 0.0
+    assert "reconnecting in 0 s (attempt 1 of 2)" in said
+    assert "reconnected after" in said and "not back after 2 attempt(s)" in said
+    times = np.array([f.time for f in frames])
+    idx = np.array([f.index for f in frames])
+    assert bool(np.all(np.diff(times) > 0)) and bool(np.all(np.diff(idx) > 0))
+    # the second connection's frames: all N, one frame interval apart, after the first's
+    first_n = len(frames) - N
+    assert 5 <= first_n < N
+    np.testing.assert_allclose(np.diff(times[first_n:]), 1.0 / FPS, atol=1e-6)
+    assert times[first_n] >= times[first_n - 1] and idx[first_n] > idx[first_n - 1]
+    # the pictures of the second connection are the file's frames from the start
+    assert np.abs(frames[first_n].image.astype(int) - _pattern(0).astype(int)).mean() < 8
+
+
+def test_reconnecting_stops_at_max_frames_and_files_never_reconnect(
+    transport_stream: bytes, stream_server: type, tmp_path: Path
+):
+    with stream_server(transport_stream, plan=("whole",)) as server:
+        reader = VideoReader(
+            f"http://127.0.0.1:{server.port}/plan.ts", reconnect=3, reconnect_wait=0.0, max_frames=4
+        )
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # no reconnection warning
+            frames = list(reader)
+        assert len(frames) == 4 and server.requests == 1
+    cut = tmp_path / "cut.ts"
+    cut.write_bytes(transport_stream[: len(transport_stream) // 2])
+    reader = VideoReader(cut, reconnect=3, reconnect_wait=0.0)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        frames = list(reader)
+    assert 0 < len(frames) < N and reader.reconnects == 0
+    assert not any("reconnect" in str(w.message) for w in caught)
+
+
+def test_a_live_source_that_never_comes_back_keeps_its_frames(
+    transport_stream: bytes, stream_server: type
+):
+    with stream_server(transport_stream, plan=("half",)) as server:
+        reader = VideoReader(
+            f"http://127.0.0.1:{server.port}/plan.ts",
+            timeout=5.0,
+            reconnect=3,
+            reconnect_wait=0.0,
+            backend="pyav",
+        )
+        with pytest.warns(VideoWarning, match=r"not back after 3 attempt\(s\); \d+ frames kept"):
+            frames = list(reader)
+        assert server.requests == 4
+    assert 5 <= len(frames) < N and reader.reconnects == 0
 
 
 # ----------------------------------------------------------------------------- images

@@ -59,7 +59,14 @@ Failure modes (issue 6, "Bad input")
   corruption) is dropped; a forward jump of more than 10 s is reported, not counted as
   lost frames;
 * a stream that drops (a network error, a truncated file) ends the iteration with a
-  warning; the frames before it have been yielded.
+  warning; the frames before it have been yielded. A live source (URL or camera) is
+  opened again instead with ``reconnect=N``: up to N attempts in a row, waiting
+  ``reconnect_wait`` seconds before the first and twice as long before each next one
+  (at most 30 s); each loss and each reconnection is reported. Frames after a
+  reconnection continue the time on the wall clock (``time`` = the last frame's time
+  plus the seconds the source was away) and the indices by the frames the source would
+  have sent meanwhile, so a consumer sees the gap (:attr:`VideoReader.reconnects`,
+  :attr:`VideoReader.lost_seconds`).
 
 :class:`VideoWriter` encodes BGR/grayscale frames with PyAV (H.264 ``libx264``,
 ``yuv420p``, with an MPEG-4 Part 2 fallback where libx264 is missing; FFV1 for 16-bit
@@ -107,6 +114,8 @@ SourceKind = Literal["file", "folder", "image", "url", "device"]
 _URL = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*://")
 _MAX_WARNINGS = 10  # individual warnings per kind before they are summarised at the end
 _MAX_GAP_S = 10.0  # [s] longer forward timestamp jumps are discontinuities, not lost frames
+RECONNECT_WAIT_MAX = 30.0
+"""Longest wait between two attempts to reopen a dropped live source [s]."""
 
 
 class VideoError(ValueError):
@@ -250,6 +259,10 @@ class VideoReader:
         timeout: seconds to wait for a live source to open or deliver data.
         backend: ``"auto"`` (PyAV, then OpenCV for live sources), ``"pyav"`` or
             ``"opencv"`` (live sources and files only).
+        reconnect: attempts to open a live source again after it drops, in a row
+            (0: the iteration ends at the drop; files and folders never reconnect).
+        reconnect_wait: seconds before the first attempt; doubled before each further
+            attempt of the same loss, at most :data:`RECONNECT_WAIT_MAX`.
 
     Attributes:
         skipped: frames lost to corruption (video) or undecodable image files (folder)
@@ -260,6 +273,8 @@ class VideoReader:
             with a warning, the others only counted; an image without a finite pixel is
             skipped and counted in ``skipped``).
         kind: ``"file"``, ``"folder"``, ``"image"``, ``"url"`` or ``"device"``.
+        reconnects: times a dropped live source was opened again (last iteration).
+        lost_seconds: seconds without frames across those reconnections [s].
     """
 
     def __init__(
@@ -274,8 +289,13 @@ class VideoReader:
         gray: bool = False,
         timeout: float = 10.0,
         backend: Literal["auto", "pyav", "opencv"] = "auto",
+        reconnect: int = 0,
+        reconnect_wait: float = 1.0,
     ) -> None:
         step = integer("step", step, 1)
+        reconnect = integer("reconnect", reconnect, 0)
+        if not (isinstance(reconnect_wait, int | float) and 0 <= reconnect_wait < math.inf):
+            raise ValueError(f"reconnect_wait: expected seconds >= 0, got {reconnect_wait!r}")
         if not (isinstance(start, int | float) and math.isfinite(start) and start >= 0):
             raise ValueError(f"start: expected a finite time >= 0 s, got {start!r}")
         if end is not None and not (isinstance(end, int | float) and end > start):
@@ -299,8 +319,12 @@ class VideoReader:
         self.gray = bool(gray)
         self.timeout = float(timeout)
         self.backend = backend
+        self.reconnect = reconnect
+        self.reconnect_wait = float(reconnect_wait)
         self.skipped = 0
         self.filled = 0
+        self.reconnects = 0
+        self.lost_seconds = 0.0
         self.kind, self._target = _classify(source)
         self.source = str(source)
         self._folder_fps = 1.0 if fps is None else float(fps)
@@ -361,14 +385,77 @@ class VideoReader:
     def __iter__(self) -> Iterator[Frame]:
         self.skipped = 0
         self.filled = 0
+        self.reconnects = 0
+        self.lost_seconds = 0.0
         if self.kind in ("folder", "image"):
             return self._iter_images()
         handle, self._handle = self._handle, None
         if handle is None:
             handle = self._open_stream()
+        if self.live and self.reconnect:
+            return self._iter_reconnecting(handle)
+        return self._iter_handle(handle, _Cursor())
+
+    def _iter_handle(self, handle: Any, cursor: _Cursor) -> Iterator[Frame]:
         if isinstance(handle, cv2.VideoCapture):
-            return self._iter_opencv(handle)
-        return self._iter_pyav(handle)
+            return self._iter_opencv(handle, cursor)
+        return self._iter_pyav(handle, cursor)
+
+    def _iter_reconnecting(self, handle: Any) -> Iterator[Frame]:
+        """Frames of a live source, opened again after each drop (``reconnect``): at most
+        ``reconnect`` attempts in a row, counted until a connection delivers a frame."""
+        cursor = _Cursor()
+        attempt = 0
+        while True:
+            before = cursor.delivered
+            if handle is not None:
+                try:
+                    yield from self._iter_handle(handle, cursor)
+                except VideoError:  # a connection without a frame: a failed attempt
+                    if cursor.index < 0:
+                        raise  # the first one: the source gives no frames at all
+                if cursor.stopped:  # end time or max_frames reached
+                    return
+                if cursor.delivered > before:
+                    if attempt:
+                        self._note_back(cursor)
+                    attempt = 0
+            if attempt == self.reconnect:
+                warnings.warn(
+                    f"{self.source}: not back after {attempt} attempt(s); "
+                    f"{cursor.delivered} frames kept",
+                    VideoWarning,
+                    stacklevel=2,
+                )
+                return
+            attempt += 1
+            wait = min(self.reconnect_wait * 2.0 ** (attempt - 1), RECONNECT_WAIT_MAX)
+            lost = f"lost after frame {cursor.index}; " if attempt == 1 else ""
+            warnings.warn(
+                f"{self.source}: {lost}reconnecting in {wait:g} s "
+                f"(attempt {attempt} of {self.reconnect})",
+                VideoWarning,
+                stacklevel=2,
+            )
+            _time.sleep(wait)
+            try:
+                handle = self._open_stream()
+            except VideoError as exc:
+                warnings.warn(str(exc), VideoWarning, stacklevel=2)
+                handle = None
+                continue
+            cursor.resume(_time.monotonic() - cursor.wall, self._rate)
+
+    def _note_back(self, cursor: _Cursor) -> None:
+        """Report a reconnection whose connection has delivered frames again."""
+        self.reconnects += 1
+        self.lost_seconds += cursor.away
+        warnings.warn(
+            f"{self.source}: reconnected after {cursor.away:.1f} s without frames; "
+            f"frames go on at index {cursor.resumed_at}",
+            VideoWarning,
+            stacklevel=3,
+        )
 
     # -------------------------------------------------------------- selection
     def _select(self, t: float, kept: int) -> tuple[bool, bool]:
@@ -617,19 +704,19 @@ class VideoReader:
         except (av.error.FFmpegError, OSError):
             return
 
-    def _iter_pyav(self, container: Any) -> Iterator[Frame]:
+    def _iter_pyav(self, container: Any, cursor: _Cursor) -> Iterator[Frame]:
         log = _Log(self.source)
         stream = container.streams.video[0]
         tb = stream.time_base
         origin = stream.start_time if (stream.start_time is not None and not self.live) else None
         interval = 1.0 / self._rate if self._rate else None
-        state = {"index": -1, "decode_errors": 0}  # index of the last frame seen
+        state = {"index": cursor.index, "decode_errors": 0}  # index of the last frame seen
         gap_missing = 0
-        shift = 0.0  # [s] added after a backward timestamp discontinuity
+        shift = cursor.offset  # [s] added to the PTS times (a discontinuity, a reconnection)
         late_run = 0  # consecutive frames older than the last one
         last_t: float | None = None
-        kept = delivered = decoded = 0
-        shape: tuple[int, ...] | None = None
+        kept, delivered, decoded = cursor.kept, cursor.delivered, 0
+        shape: tuple[int, ...] | None = cursor.shape
         ended_by_user = False
         try:
             for vf in self._decoded(container, log, state):
@@ -695,13 +782,15 @@ class VideoReader:
                         f"{_fmt_shape(image.shape)}",
                     )
                 shape = image.shape
+                cursor.seen(state["index"], t, kept, delivered + 1, shape)
                 yield Frame(index=state["index"], time=t, image=image)
                 delivered += 1
                 if self.max_frames is not None and delivered >= self.max_frames:
                     ended_by_user = True
                     break
         finally:
-            self.skipped = max(state["decode_errors"], gap_missing)
+            self.skipped = cursor.skipped + max(state["decode_errors"], gap_missing)
+            cursor.close(self.skipped, kept, ended_by_user)
             container.close()
             log.summary()
         if decoded == 0:
@@ -723,12 +812,13 @@ class VideoReader:
             )
 
     # -------------------------------------------------------------- OpenCV iteration
-    def _iter_opencv(self, cap: cv2.VideoCapture) -> Iterator[Frame]:
+    def _iter_opencv(self, cap: cv2.VideoCapture, cursor: _Cursor) -> Iterator[Frame]:
         log = _Log(self.source)
-        kept = delivered = 0
-        index = -1
-        t0 = _time.monotonic()
-        shape: tuple[int, ...] | None = None
+        kept, delivered = cursor.kept, cursor.delivered
+        index = cursor.index
+        t0 = _time.monotonic() - cursor.offset  # live: wall-clock time since the first frame
+        shape: tuple[int, ...] | None = cursor.shape
+        stopped = False
         try:
             while True:
                 ok, img = cap.read()
@@ -743,6 +833,7 @@ class VideoReader:
                     t = (_time.monotonic() - t0) if self.live else index / (self._rate or 25.0)
                 take, stop = self._select(t, kept)
                 if stop:
+                    stopped = True
                     break
                 if t < self.start:
                     continue
@@ -757,15 +848,59 @@ class VideoReader:
                         f"{_fmt_shape(image.shape)}",
                     )
                 shape = image.shape
+                cursor.seen(index, t, kept, delivered + 1, shape)
                 yield Frame(index=index, time=t, image=image)
                 delivered += 1
                 if self.max_frames is not None and delivered >= self.max_frames:
+                    stopped = True
                     break
         finally:
+            cursor.close(cursor.skipped, kept, stopped)
             cap.release()
             log.summary()
         if index < 0:
             raise VideoError(f"{self._describe()}: no decodable video frames")
+
+
+@dataclass
+class _Cursor:
+    """Where an iteration over a stream stands, carried across reconnections: the source
+    index to go on from, the last frame delivered (index, time [s], image shape, wall
+    clock [s]), the frames in the window and delivered, frames skipped so far, the time
+    offset [s] for the next connection's PTS, and whether the iteration was ended by
+    ``end`` / ``max_frames``."""
+
+    index: int = -1
+    last: int = -1
+    time: float | None = None
+    kept: int = 0
+    delivered: int = 0
+    skipped: int = 0
+    offset: float = 0.0
+    shape: tuple[int, ...] | None = None
+    wall: float = 0.0
+    stopped: bool = False
+    away: float = 0.0
+    resumed_at: int = 0
+
+    def seen(self, index: int, t: float, kept: int, delivered: int, shape: tuple[int, ...]) -> None:
+        """A frame is being delivered."""
+        self.index = self.last = index
+        self.time, self.kept, self.delivered = t, kept, delivered
+        self.shape, self.wall = shape, _time.monotonic()
+
+    def close(self, skipped: int, kept: int, stopped: bool) -> None:
+        """The connection ended (``stopped``: by ``end`` or ``max_frames``)."""
+        self.skipped, self.kept, self.stopped = skipped, kept, stopped
+
+    def resume(self, away: float, rate: float | None) -> None:
+        """A new connection ``away`` seconds after the last frame: its first frame is
+        that long after the last one, its index after the frames sent meanwhile at
+        ``rate`` [1/s] (the next index if the rate is unknown)."""
+        self.away = away
+        self.offset = (self.time or 0.0) + away
+        self.resumed_at = self.last + (max(1, round(away * rate)) if rate else 1)
+        self.index = self.resumed_at - 1
 
 
 class _Log:
