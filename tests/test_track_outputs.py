@@ -275,24 +275,83 @@ def test_dark_polarity_into_the_sun_drops_the_glitter_tracks_and_keeps_the_ferry
     assert dark["fp"] < 0.3 * dark["truth_rows"] and dark["mota"] > 0.6
 
 
-def _two_sizes(clip: Path, path: Path, size: tuple[int, int], at: int = 40) -> Path:
-    """The clip's frames as two transport streams back to back: frames before ``at`` as
-    they are, the rest scaled to ``size`` (a stream whose resolution changes)."""
+def _halves(
+    clip: Path, folder: Path, at: int = 40, size: tuple[int, int] | None = None, gap: float = 0.0
+) -> tuple[bytes, bytes]:
+    """The clip's frames as two transport streams: frames before ``at`` as they are, the
+    rest scaled to ``size`` (None: as they are) and with their timestamps ``gap`` seconds
+    later (a recording with a gap; 0: starting again from the stream's origin)."""
     import cv2
 
     from seawatch.io.video import VideoReader, VideoWriter
 
     parts = []
     for k, (lo, hi) in enumerate(((0, at), (at, None))):
-        part = path.with_name(f"{path.stem}-{k}.ts")
-        with VideoWriter(part, 25.0, gop=5) as writer, VideoReader(clip / "video.mp4") as reader:
+        part = folder / f"part-{k}.ts"
+        offset = {"output_ts_offset": f"{gap:g}"} if k and gap else None
+        with (
+            VideoWriter(part, 25.0, gop=5, container_options=offset) as writer,
+            VideoReader(clip / "video.mp4") as reader,
+        ):
             for fr in reader:
                 if fr.index >= lo and (hi is None or fr.index < hi):
-                    image = fr.image if k == 0 else cv2.resize(fr.image, size, cv2.INTER_AREA)
-                    writer.write(image)
+                    scale = k and size is not None
+                    writer.write(cv2.resize(fr.image, size, cv2.INTER_AREA) if scale else fr.image)
         parts.append(part.read_bytes())
-    path.write_bytes(b"".join(parts))
+    return parts[0], parts[1]
+
+
+def _two_sizes(clip: Path, path: Path, size: tuple[int, int], at: int = 40) -> Path:
+    """The clip's frames as two transport streams back to back: frames before ``at`` as
+    they are, the rest scaled to ``size`` (a stream whose resolution changes)."""
+    path.write_bytes(b"".join(_halves(clip, path.parent, at, size)))
     return path
+
+
+def _track_ids(rows: list[dict[str, str]], frames: range) -> set[str]:
+    return {r["track_id"] for r in rows if int(r["frame"]) in frames}
+
+
+def test_a_gap_in_the_recording_restarts_the_tracks(clip, tmp_path):
+    """Frames 40–79 over four seconds after frame 39 (a recording with a gap): the ship is
+    tracked on both sides, under new ids after the gap, and the summary says why (before,
+    the tracks went on across the gap as if one frame had passed)."""
+    video = tmp_path / "gap.ts"
+    video.write_bytes(b"".join(_halves(clip, tmp_path, gap=6.0)))
+    res = runner.invoke(app, ["track", str(video), "--out", str(tmp_path / "out"),
+                              "--no-video", "--no-report", "--json"])  # fmt: skip
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout[res.stdout.index("{") :])
+    assert any("s after the frame before" in w and "restart" in w for w in doc["warnings"])
+    rows = _rows(tmp_path / "out" / "tracks.csv")
+    first = max(int(r["frame"]) for r in rows if int(r["frame"]) < 100)
+    before, after = _track_ids(rows, range(first + 1)), _track_ids(rows, range(100, 10**6))
+    assert before and after and before.isdisjoint(after)
+    times = sorted({float(r["time"]) for r in rows})
+    assert max(np.diff(times)) > 4.0  # the gap (6 s after the first half began) is kept
+
+
+def test_track_reconnects_a_dropped_stream_and_keeps_the_ship(clip, tmp_path, stream_server):
+    """A live HTTP source that ends after frame 39 and comes back with frames 40–79 a
+    second later (``--reconnect 1``): one track follows the ship through the drop, the
+    frame indices go on past the second without frames, and the run ends cleanly when the
+    source does not come back again."""
+    first, second = _halves(clip, tmp_path)
+    with stream_server(b"", plan=(first, second)) as server:
+        res = runner.invoke(app, ["track", f"http://127.0.0.1:{server.port}/plan.ts",
+                                  "--reconnect", "1", "--out", str(tmp_path / "out"),
+                                  "--no-video", "--no-report", "--json"])  # fmt: skip
+        assert server.requests >= 3  # both halves, then the source is down
+    assert res.exit_code == 0, res.output
+    assert "reconnected after" in res.output and "not back after 1 attempt(s)" in res.output
+    doc = json.loads(res.stdout[res.stdout.index("{") :])
+    assert doc["frames"] == 80
+    rows = _rows(tmp_path / "out" / "tracks.csv")
+    frames = sorted({int(r["frame"]) for r in rows})
+    jump = int(np.max(np.diff(frames)))
+    assert jump >= 20  # about 25 frames a second away
+    resumed = frames[int(np.argmax(np.diff(frames))) + 1]
+    assert _track_ids(rows, range(resumed)) & _track_ids(rows, range(resumed, 10**6))
 
 
 def test_a_resolution_change_scales_the_camera_and_restarts_the_tracks(clip, tmp_path):

@@ -414,6 +414,7 @@ def track_video(
     attitude: AttitudeMode = "auto",
     step: int = 1,
     max_frames: int | None = None,
+    reconnect: int = 0,
     sigma_px: float = PIXEL_SIGMA,
     annotate: bool = True,
     report: bool = True,
@@ -446,6 +447,9 @@ def track_video(
             the demo clip both give geometry 80 m RMS, the horizon being found to
             0.03 px).
         step, max_frames: frame decimation and limit.
+        reconnect: attempts to reopen a live source that drops (:class:`VideoReader`);
+            frames more than ``max(COAST_SECONDS, 3 step / fps)`` apart (a reconnection, a
+            gap in a recording) restart the visual tracks with new ids.
         sigma_px: 1-σ of the water-line pixel [px].
         annotate, report, parquet: write ``annotated.mp4``, ``report.html``,
             ``tracks.parquet``.
@@ -494,8 +498,9 @@ def track_video(
         note("--ais: no --start and no clip.json beside the video: AIS cross-check skipped")
         ais = None
 
-    reader = VideoReader(source, step=step, max_frames=max_frames)
+    reader = VideoReader(source, step=step, max_frames=max_frames, reconnect=reconnect)
     fps = reader.fps or 25.0
+    gap_limit = max(COAST_SECONDS, 3.0 * step / fps)  # [s] a longer gap ends every track
     coast = max(REPORT_COAST_FRAMES, round(COAST_SECONDS * fps))
     vtracker = VisualTracker(detector=detector, filter=filter, fps=fps, delete_after=coast)
     pose = _Pose(camera, platform, start, attitude, notes) if camera is not None else None
@@ -544,19 +549,32 @@ def track_video(
     # another (VisualTracker.stream) while this one is tracked and written
     frames_ahead = vtracker.stream(reader)
     size: tuple[int, int] | None = None
+    last_time: float | None = None
+
+    def restart(why: str) -> None:
+        """New visual tracks (new ids) and no world tracks, with a note saying why."""
+        nonlocal live_ids
+        note(f"{why}: the visual tracks restart with new ids")
+        vtracker.restart_tracks()
+        if world is not None:
+            world.drop(np.fromiter(live_ids, np.int64))
+            live_ids = set()
+
     try:
         for frame, horizon, detections in frames_ahead:
+            if last_time is not None and frame.time - last_time > gap_limit:
+                restart(
+                    f"frame {frame.index}: {frame.time - last_time:.1f} s after the frame before "
+                    "(a stream that dropped, a gap in the recording)"
+                )
+            last_time = float(frame.time)
             shape = frame.image.shape
             if (shape[1], shape[0]) != size:
                 if size is not None:  # the stream's resolution changed (VideoReader warns)
-                    note(
+                    restart(
                         f"frame {frame.index}: the frame size changed from {size[0]}x{size[1]} "
-                        f"to {shape[1]}x{shape[0]}: the visual tracks restart with new ids"
+                        f"to {shape[1]}x{shape[0]}"
                     )
-                    vtracker.restart_tracks()
-                    if world is not None:
-                        world.drop(np.fromiter(live_ids, np.int64))
-                        live_ids = set()
                 size = (shape[1], shape[0])
                 if pose is not None and camera is not None:
                     where = f"frame {frame.index} of {source}"

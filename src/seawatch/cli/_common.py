@@ -49,6 +49,14 @@ EndOption = Annotated[float | None, typer.Option(help="Time to stop at [s] (excl
 MaxFramesOption = Annotated[
     int | None, typer.Option("--max-frames", help="Stop after this many frames.", min=1)
 ]
+ReconnectOption = Annotated[
+    int,
+    typer.Option(
+        help="Live source (URL, camera) that drops: reopen it up to N times in a row, "
+        "waiting 1, 2, 4 ... s (at most 30 s); 0: stop at the drop.",
+        min=0,
+    ),
+]
 
 
 def check_span(start: float, end: float | None) -> None:

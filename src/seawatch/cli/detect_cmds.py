@@ -35,6 +35,7 @@ from seawatch.cli._common import (
     EndOption,
     FpsOption,
     MaxFramesOption,
+    ReconnectOption,
     SourceArgument,
     StartOption,
     StepOption,
@@ -154,6 +155,7 @@ def detect(
     start: StartOption = 0.0,
     end: EndOption = None,
     max_frames: MaxFramesOption = None,
+    reconnect: ReconnectOption = 0,
 ) -> None:
     """Detect ships in every frame of a video, stream or image folder.
 
@@ -173,7 +175,13 @@ def detect(
             model, threshold=threshold, polarity=polarity, temporal=temporal, mask=mask
         )
         reader = VideoReader(
-            source, step=step, start=start, end=end, max_frames=max_frames, fps=fps
+            source,
+            step=step,
+            start=start,
+            end=end,
+            max_frames=max_frames,
+            fps=fps,
+            reconnect=reconnect,
         )
         horizon_of = _horizon_source(reader, use_horizon)
         records, failure = frame_records(

@@ -34,6 +34,7 @@ from seawatch.cli._common import (
     EndOption,
     FpsOption,
     MaxFramesOption,
+    ReconnectOption,
     SourceArgument,
     StartOption,
     StepOption,
@@ -91,6 +92,7 @@ def horizon(
     start: StartOption = 0.0,
     end: EndOption = None,
     max_frames: MaxFramesOption = None,
+    reconnect: ReconnectOption = 0,
     smooth: Annotated[
         bool | None,
         typer.Option(
@@ -117,7 +119,13 @@ def horizon(
     with exit_codes(), warnings_to_stderr():
         check_span(start, end)
         reader = VideoReader(
-            source, step=step, start=start, end=end, max_frames=max_frames, fps=fps
+            source,
+            step=step,
+            start=start,
+            end=end,
+            max_frames=max_frames,
+            fps=fps,
+            reconnect=reconnect,
         )
         use_tracker = (reader.kind not in ("folder", "image")) if smooth is None else smooth
         tracker = HorizonTracker(max_tilt_deg=max_tilt, fps=reader.fps or 25.0)
