@@ -153,6 +153,22 @@ def test_outputs_are_consistent_with_each_other(clip, horizon_run):
         assert math.hypot(dn, de) == pytest.approx(float(r["speed_mps"]) * tau, rel=1e-3)
 
 
+@pytest.mark.parametrize("option", [["--step", "2"], ["--max-frames", "30"]])
+def test_truth_is_scored_on_the_frames_tracked_only(clip, tmp_path, option):
+    """With --step or --max-frames the frames not tracked are not misses (before, every
+    truth frame was scored: MOTA 0.49 with --step 2 on a 200-frame clip that has 0.99)."""
+    res = runner.invoke(app, ["track", str(clip / "video.mp4"), "--truth",
+                              str(clip / "truth.csv"), "--out", str(tmp_path / "out"),
+                              "--no-video", "--no-report", "--json", *option])  # fmt: skip
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout[res.stdout.index("{") :])
+    errors = doc["errors"]
+    assert doc["frames"] in (30, 40)
+    assert errors["frames_scored"] == doc["frames"] == errors["truth_rows"]
+    # the ship is found in all but the first frames of confirmation (3 of 5)
+    assert errors["fn"] <= 3 and errors["mota"] > 0.9
+
+
 def test_target_above_the_horizon_gives_angles_without_range(clip, tmp_path):
     cam = load_camera(clip / "camera.yaml")
     # a camera file 2 deg more nose-up than the camera was: the ship's water line (0.9 deg

@@ -541,6 +541,7 @@ def track_video(
     video_out = None
     total = reader.frame_count
     frames = 0
+    done: list[int] = []  # source indices of the frames tracked (scored with --truth)
     ids: set[int] = set()
     labels: dict[int, int | None] = {}
     live_ids: set[int] = set()
@@ -677,6 +678,7 @@ def track_video(
                     frame.image, records, horizon, time=t, frame=int(frame.index), fit=True
                 )
             frames += 1
+            done.append(int(frame.index))
             if progress is not None:
                 progress(frames, total)
     except KeyboardInterrupt:
@@ -705,6 +707,7 @@ def track_video(
             camera=camera,
             estimates=out / "estimates.csv" if est_out is not None else None,
             min_truth_height=MIN_TRUTH_PX,
+            frames=done,  # a frame skipped by --step or --max-frames is no miss
         ).to_json()
     run = TrackRun(
         frames=frames,
