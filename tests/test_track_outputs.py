@@ -153,10 +153,13 @@ def test_outputs_are_consistent_with_each_other(clip, horizon_run):
         assert math.hypot(dn, de) == pytest.approx(float(r["speed_mps"]) * tau, rel=1e-3)
 
 
-@pytest.mark.parametrize("option", [["--step", "2"], ["--max-frames", "30"]])
+@pytest.mark.parametrize(
+    "option", [["--step", "2"], ["--max-frames", "30"], ["--begin", "1", "--end", "2.2"]]
+)
 def test_truth_is_scored_on_the_frames_tracked_only(clip, tmp_path, option):
-    """With --step or --max-frames the frames not tracked are not misses (before, every
-    truth frame was scored: MOTA 0.49 with --step 2 on a 200-frame clip that has 0.99)."""
+    """With --step, --max-frames or a --begin/--end window the frames not tracked are not
+    misses (before, every truth frame was scored: MOTA 0.49 with --step 2 on a 200-frame
+    clip that has 0.99)."""
     res = runner.invoke(app, ["track", str(clip / "video.mp4"), "--truth",
                               str(clip / "truth.csv"), "--out", str(tmp_path / "out"),
                               "--no-video", "--no-report", "--json", *option])  # fmt: skip
@@ -165,6 +168,10 @@ def test_truth_is_scored_on_the_frames_tracked_only(clip, tmp_path, option):
     errors = doc["errors"]
     assert doc["frames"] in (30, 40)
     assert errors["frames_scored"] == doc["frames"] == errors["truth_rows"]
+    if "--begin" in option:  # frames 25-54 (1.0 <= time < 2.2 s), their own times
+        rows = _rows(tmp_path / "out" / "tracks.csv")
+        assert {int(r["frame"]) for r in rows} <= set(range(25, 55))
+        assert all(1.0 <= float(r["time"]) < 2.2 for r in rows)
     # the ship is found in all but the first frames of confirmation (3 of 5)
     assert errors["fn"] <= 3 and errors["mota"] > 0.9
 
@@ -262,6 +269,8 @@ def test_bad_inputs_exit_2_naming_the_input(clip, tmp_path):
     blocker.write_text("")
     res = runner.invoke(app, ["track", video, "--out", str(blocker / "out")])
     assert res.exit_code == 2 and "cannot write" in res.output
+    res = runner.invoke(app, ["track", video, "--begin", "2", "--end", "1", "--out", str(tmp_path)])
+    assert res.exit_code == 2 and "--end: must be after --begin" in res.output
     res = runner.invoke(app, ["track", video, "--polarity", "grey", "--out", str(tmp_path)])
     assert res.exit_code == 2 and "--polarity" in res.output
     model = str(tmp_path / "ships.onnx")

@@ -414,6 +414,8 @@ def track_video(
     attitude: AttitudeMode = "auto",
     step: int = 1,
     max_frames: int | None = None,
+    begin: float = 0.0,
+    end: float | None = None,
     reconnect: int = 0,
     sigma_px: float = PIXEL_SIGMA,
     annotate: bool = True,
@@ -447,6 +449,8 @@ def track_video(
             the demo clip both give geometry 80 m RMS, the horizon being found to
             0.03 px).
         step, max_frames: frame decimation and limit.
+        begin, end: the video times to track, ``begin <= time < end`` [s from the video's
+            start] (``start`` stays the UTC time of the video's frame 0).
         reconnect: attempts to reopen a live source that drops (:class:`VideoReader`);
             frames more than ``max(COAST_SECONDS, 3 step / fps)`` apart (a reconnection, a
             gap in a recording) restart the visual tracks with new ids.
@@ -498,7 +502,9 @@ def track_video(
         note("--ais: no --start and no clip.json beside the video: AIS cross-check skipped")
         ais = None
 
-    reader = VideoReader(source, step=step, max_frames=max_frames, reconnect=reconnect)
+    reader = VideoReader(
+        source, step=step, max_frames=max_frames, start=begin, end=end, reconnect=reconnect
+    )
     fps = reader.fps or 25.0
     gap_limit = max(COAST_SECONDS, 3.0 * step / fps)  # [s] a longer gap ends every track
     coast = max(REPORT_COAST_FRAMES, round(COAST_SECONDS * fps))
@@ -539,7 +545,7 @@ def track_video(
         associator = AisAssociator(ais, lat0=lat0, lon0=lon0)
         ais_every = max(1, round(fps / step / AIS_RATE))
     video_out = None
-    total = reader.frame_count
+    total = reader.expected_frames
     frames = 0
     done: list[int] = []  # source indices of the frames tracked (scored with --truth)
     ids: set[int] = set()

@@ -91,6 +91,16 @@ def test_step_start_end_and_max_frames_select_the_right_frames(clip: Path):
     assert list(VideoReader(clip, start=100.0)) == []  # frames exist, none in the window
 
 
+@pytest.mark.parametrize(
+    "kwargs",
+    [{}, {"step": 3, "start": 0.2, "end": 1.0}, {"step": 4, "max_frames": 3}, {"start": 1.5},
+     {"start": 100.0}, {"end": 0.5, "step": 2}, {"start": 0.21, "end": 0.99}],
+)  # fmt: skip
+def test_expected_frames_is_what_the_iteration_delivers(clip: Path, kwargs: dict):
+    reader = VideoReader(clip, **kwargs)
+    assert reader.expected_frames == len(list(reader))
+
+
 def test_opencv_backend_reads_the_same_frames_and_times(clip: Path):
     frames = list(VideoReader(clip, backend="opencv"))
     assert [f.index for f in frames] == list(range(N))

@@ -59,10 +59,10 @@ ReconnectOption = Annotated[
 ]
 
 
-def check_span(start: float, end: float | None) -> None:
-    """:class:`BadInput` naming ``--end`` unless it is after ``--start`` (or absent)."""
+def check_span(start: float, end: float | None, first: str = "--start") -> None:
+    """:class:`BadInput` naming ``--end`` unless it is after ``first`` (or absent)."""
     if end is not None and end <= start:
-        raise BadInput(f"--end: must be after --start ({start} s), got {end} s")
+        raise BadInput(f"--end: must be after {first} ({start} s), got {end} s")
 
 
 def _plain(obj: Any) -> Any:
@@ -138,14 +138,6 @@ def open_csv(output: Path | None, columns: Sequence[str]) -> tuple[TextIO | None
     writer.writerow(columns)
     sink.flush()
     return sink, writer
-
-
-def expected_frames(frame_count: int | None, step: int, max_frames: int | None) -> int | None:
-    """Frames a reader will deliver (for a progress bar), None when unknown (live)."""
-    if frame_count is None:
-        return None
-    total = max(1, math.ceil(frame_count / step))
-    return total if max_frames is None else min(total, max_frames)
 
 
 def frame_records(

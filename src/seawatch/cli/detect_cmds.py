@@ -43,7 +43,6 @@ from seawatch.cli._common import (
     emit_json,
     err,
     exit_codes,
-    expected_frames,
     frame_records,
     warnings_to_stderr,
 )
@@ -191,7 +190,7 @@ def detect(
             output=output,
             columns=CSV_COLUMNS,
             csv_rows=_csv_rows,
-            total=expected_frames(reader.frame_count, step, max_frames),
+            total=reader.expected_frames,
         )
         n_boxes = sum(len(rec["boxes"]) for rec in records)
         err.print(

@@ -42,7 +42,6 @@ from seawatch.cli._common import (
     emit_json,
     err,
     exit_codes,
-    expected_frames,
     frame_records,
     warnings_to_stderr,
 )
@@ -142,7 +141,7 @@ def horizon(
             output=output,
             columns=CSV_COLUMNS,
             csv_rows=lambda rec: [_csv_row(rec)],
-            total=expected_frames(reader.frame_count, step, max_frames),
+            total=reader.expected_frames,
         )
         found = sum(r["found"] for r in records)
         err.print(

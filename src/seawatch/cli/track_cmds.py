@@ -13,9 +13,11 @@ import typer
 from seawatch.cli._common import (
     EXIT_FAILED,
     BadInput,
+    EndOption,
     MaxFramesOption,
     ReconnectOption,
     StepOption,
+    check_span,
     emit_json,
     err,
     exit_codes,
@@ -140,6 +142,15 @@ def track(
     ] = 1.0,
     step: StepOption = 1,
     max_frames: MaxFramesOption = None,
+    begin: Annotated[
+        float,
+        typer.Option(
+            help="First video time to track [s from the video's start] (--start is the UTC "
+            "time of the video's frame 0).",
+            min=0.0,
+        ),
+    ] = 0.0,
+    end: EndOption = None,
     reconnect: ReconnectOption = 0,
     video: Annotated[bool, typer.Option(help="Write annotated.mp4.")] = True,
     report: Annotated[bool, typer.Option(help="Write report.html.")] = True,
@@ -171,6 +182,7 @@ def track(
         if filter not in ("afkf", "fkf", "kf"):
             raise BadInput(f"--filter: expected afkf, fkf or kf, got {filter!r}")
         check_options(estimator, attitude)
+        check_span(begin, end, "--begin")
         detector = make_detector(
             model, threshold=threshold, polarity=polarity, temporal=temporal, mask=mask
         )
@@ -200,6 +212,8 @@ def track(
                 sigma_px=pixel_sigma,
                 step=step,
                 max_frames=max_frames,
+                begin=begin,
+                end=end,
                 reconnect=reconnect,
                 annotate=video,
                 report=report,

@@ -364,6 +364,21 @@ class VideoReader:
         """
         return self._count
 
+    @property
+    def expected_frames(self) -> int | None:
+        """Frames an iteration will deliver, after ``start``/``end``/``step``/
+        ``max_frames`` (for a progress bar; the window from the nominal rate); None when
+        the source's length is unknown (a live source)."""
+        if self._count is None:
+            return None
+        first, last = 0, self._count
+        if self._rate:
+            first = min(last, math.ceil(self.start * self._rate - 1e-9))
+            if self.end is not None:
+                last = min(last, math.ceil(self.end * self._rate - 1e-9))
+        total = math.ceil(max(0, last - first) / self.step)
+        return total if self.max_frames is None else min(total, self.max_frames)
+
     def __repr__(self) -> str:
         return f"VideoReader({self.source!r}, kind={self.kind!r}, size={self._size})"
 
