@@ -176,6 +176,37 @@ def test_truth_is_scored_on_the_frames_tracked_only(clip, tmp_path, option):
     assert errors["fn"] <= 3 and errors["mota"] > 0.9
 
 
+def test_an_image_folder_is_tracked_at_its_fps(clip, tmp_path):
+    """The clip's frames as PNG files: with --fps 25 the rows have the video's times and the
+    ship's speed is the truth's 7 m/s; without it the frames are 1 s apart, with a warning
+    saying so (before, there was no --fps: every folder was tracked at 1 frame/s)."""
+    import cv2
+
+    from seawatch.io.video import VideoReader
+
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    with VideoReader(clip / "video.mp4") as reader:
+        for fr in reader:
+            cv2.imwrite(str(folder / f"f{fr.index:03d}.png"), fr.image)
+    speeds = {}
+    for fps in (None, 25.0):
+        out = tmp_path / f"out-{fps}"
+        args = ["track", str(folder), "--camera", str(clip / "camera.yaml"), "--attitude",
+                "horizon", "--out", str(out), "--no-video", "--no-report", "--json"]  # fmt: skip
+        res = runner.invoke(app, args + ([] if fps is None else ["--fps", str(fps)]))
+        assert res.exit_code == 0, res.output
+        said = " ".join(json.loads(res.stdout[res.stdout.index("{") :])["warnings"])
+        assert ("without --fps" in said) == (fps is None)
+        rows = _rows(out / "tracks.csv")
+        rate = 1.0 if fps is None else fps
+        assert all(abs(float(r["time"]) - int(r["frame"]) / rate) < 1e-6 for r in rows)
+        late = [float(r["speed_mps"]) for r in rows if int(r["frame"]) >= 60]
+        speeds[fps] = float(np.median(late))
+    assert abs(speeds[25.0] - 7.0) < 1.5  # the truth's 7 m/s
+    assert speeds[None] < 1.0  # 25 times too slow without the frame rate
+
+
 def test_target_above_the_horizon_gives_angles_without_range(clip, tmp_path):
     cam = load_camera(clip / "camera.yaml")
     # a camera file 2 deg more nose-up than the camera was: the ship's water line (0.9 deg

@@ -416,6 +416,7 @@ def track_video(
     max_frames: int | None = None,
     begin: float = 0.0,
     end: float | None = None,
+    fps: float | None = None,
     reconnect: int = 0,
     sigma_px: float = PIXEL_SIGMA,
     annotate: bool = True,
@@ -451,6 +452,8 @@ def track_video(
         step, max_frames: frame decimation and limit.
         begin, end: the video times to track, ``begin <= time < end`` [s from the video's
             start] (``start`` stays the UTC time of the video's frame 0).
+        fps: frame rate of an image folder [1/s] (its frames' times, hence speeds and
+            how long a track coasts); None: 1, with a warning when positions are made.
         reconnect: attempts to reopen a live source that drops (:class:`VideoReader`);
             frames more than ``max(COAST_SECONDS, 3 step / fps)`` apart (a reconnection, a
             gap in a recording) restart the visual tracks with new ids.
@@ -503,8 +506,19 @@ def track_video(
         ais = None
 
     reader = VideoReader(
-        source, step=step, max_frames=max_frames, start=begin, end=end, reconnect=reconnect
+        source,
+        step=step,
+        max_frames=max_frames,
+        start=begin,
+        end=end,
+        fps=fps,
+        reconnect=reconnect,
     )
+    if fps is None and reader.kind == "folder" and camera is not None:
+        note(
+            f"{source}: an image folder without --fps: frames taken 1 s apart (speeds, "
+            "courses and forecasts assume it)"
+        )
     fps = reader.fps or 25.0
     gap_limit = max(COAST_SECONDS, 3.0 * step / fps)  # [s] a longer gap ends every track
     coast = max(REPORT_COAST_FRAMES, round(COAST_SECONDS * fps))
