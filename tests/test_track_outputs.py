@@ -207,6 +207,38 @@ def test_an_image_folder_is_tracked_at_its_fps(clip, tmp_path):
     assert speeds[None] < 1.0  # 25 times too slow without the frame rate
 
 
+@pytest.mark.parametrize(("gap", "same_id"), [((100, 140), True), ((100, 200), False)])
+def test_a_track_coasts_three_seconds_whatever_the_step(tmp_path, gap, same_id):
+    """Every 5th frame of a 25 frame/s folder: a ship unseen for 1.6 s keeps its id, one
+    unseen for 4 s gets a new one (COAST_SECONDS = 3 s). Before, the coasting limit was
+    counted in source frames but spent in frames tracked: 15 s at --step 5."""
+    import cv2
+
+    from seawatch.vision.external import CallableDetector
+
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    for k in range(300):  # the frame number in two pixels
+        img = np.zeros((64, 96), np.uint8)
+        img[0, 0], img[0, 1] = k % 256, k // 256
+        cv2.imwrite(str(folder / f"f{k:03d}.png"), img)
+
+    def ship(image: np.ndarray) -> np.ndarray:
+        k = int(image[0, 0]) + 256 * int(image[0, 1])
+        if gap[0] <= k < gap[1]:
+            return np.empty((0, 4))
+        return np.array([[10.0 + 0.1 * k, 30.0, 20.0, 8.0]])
+
+    detector = CallableDetector(ship, refine_waterline=False)
+    out = tmp_path / "out"
+    track_video(folder, out, fps=25.0, step=5, detector=detector, annotate=False, report=False)
+    rows = _rows(out / "tracks.csv")
+    before = _track_ids(rows, range(gap[0]))
+    after = _track_ids(rows, range(gap[1], 300))
+    assert len(before) == len(after) == 1
+    assert (before == after) == same_id
+
+
 def test_target_above_the_horizon_gives_angles_without_range(clip, tmp_path):
     cam = load_camera(clip / "camera.yaml")
     # a camera file 2 deg more nose-up than the camera was: the ship's water line (0.9 deg

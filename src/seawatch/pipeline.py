@@ -521,7 +521,7 @@ def track_video(
         )
     fps = reader.fps or 25.0
     gap_limit = max(COAST_SECONDS, 3.0 * step / fps)  # [s] a longer gap ends every track
-    coast = max(REPORT_COAST_FRAMES, round(COAST_SECONDS * fps))
+    coast = max(REPORT_COAST_FRAMES, round(COAST_SECONDS * fps / step))  # frames tracked
     vtracker = VisualTracker(detector=detector, filter=filter, fps=fps, delete_after=coast)
     pose = _Pose(camera, platform, start, attitude, notes) if camera is not None else None
     world = None
