@@ -62,6 +62,30 @@ def test_on_a_local_dask_cluster_a_bad_recording_fails_alone(clips, tmp_path):
     assert (tmp_path / "out" / "video" / "tracks.csv").is_file()
 
 
+def test_step_and_fps_reach_each_recording(clips, tmp_path):
+    """--step 2 tracks every other frame of each 30-frame recording; --fps times the frames
+    of an image folder (the first recording's frames as PNG files, at 25 frames/s)."""
+    import cv2
+
+    from seawatch.io.video import VideoReader
+
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    with VideoReader(clips / "a" / "video.mp4") as reader:
+        for fr in reader:
+            cv2.imwrite(str(folder / f"f{fr.index:03d}.png"), fr.image)
+    args = ["batch", str(clips / "b" / "video.mp4"), str(folder), "--step", "2", "--fps", "25",
+            "--out", str(tmp_path / "out"), "--workers", "1", "--no-video", "--no-report",
+            "--json"]  # fmt: skip
+    res = runner.invoke(app, args)
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    assert [it["summary"]["frames"] for it in doc["items"]] == [15, 15]
+    rows = _rows(tmp_path / "out" / "frames" / "tracks.csv")
+    assert rows and all(int(r["frame"]) % 2 == 0 for r in rows)
+    assert all(abs(float(r["time"]) - int(r["frame"]) / 25.0) < 1e-6 for r in rows)
+
+
 def test_bad_batch_inputs_exit_2(clips, tmp_path):
     video = str(clips / "a" / "video.mp4")
     res = runner.invoke(app, ["batch", video, "--camera", str(tmp_path / "none.yaml")])

@@ -26,6 +26,8 @@ from seawatch.cli import (
 from seawatch.cli._common import (
     EXIT_FAILED,
     BadInput,
+    FpsOption,
+    StepOption,
     emit_json,
     err,
     exit_codes,
@@ -348,6 +350,8 @@ def batch(
     polarity: PolarityOption = "both",
     mask: MaskOption = None,
     temporal: TemporalOption = False,
+    step: StepOption = 1,
+    fps: FpsOption = None,
     workers: Annotated[
         int | None,
         typer.Option(help="Local Dask worker processes (default: the cores; 1: no Dask).", min=1),
@@ -381,6 +385,8 @@ def batch(
                 attitude=attitude,
                 annotate=video,
                 report=report,
+                step=step,
+                fps=fps,
                 detector_options={
                     "model": model,
                     "threshold": threshold,
