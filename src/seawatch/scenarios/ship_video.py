@@ -64,20 +64,37 @@ def read_truth(path: str | Path) -> np.ndarray:
     return np.array(rows, dtype=np.float64).reshape(-1, 6)
 
 
-def detect_video(video: str | Path, tracker: VisualTracker | None = None) -> list[np.ndarray]:
-    """Per-frame detections (k, 7) of a video (horizon + detector of ``tracker``)."""
+def detect_video(
+    video: str | Path,
+    tracker: VisualTracker | None = None,
+    offsets: list[np.ndarray] | None = None,
+) -> list[np.ndarray]:
+    """Per-frame detections (k, 7) of a video (horizon + detector of ``tracker``); with a
+    list ``offsets``, each frame's camera offset is appended to it
+    (:meth:`VisualTracker.next_offset`)."""
     vt = tracker if tracker is not None else VisualTracker()
     vt.reset()
+    out = []
     with VideoReader(video) as reader:
-        return [det for _, _, det in vt.stream(reader)]
+        for _, _, det in vt.stream(reader):
+            out.append(det)
+            offset = vt.next_offset()
+            if offsets is not None:
+                offsets.append(offset)
+    return out
 
 
 def track_case(
-    detections: Sequence[np.ndarray], truth: np.ndarray, filter: str, **options: Any
+    detections: Sequence[np.ndarray],
+    truth: np.ndarray,
+    filter: str,
+    offsets: Sequence[np.ndarray] | None = None,
+    **options: Any,
 ) -> CLEResult:
-    """CLE (§1.6) of :class:`VisualTracker` with ``filter`` on precomputed detections."""
+    """CLE (§1.6) of :class:`VisualTracker` with ``filter`` on precomputed detections
+    (and the frames' camera ``offsets``, :func:`detect_video`)."""
     vt = VisualTracker(detector=_no_detector, filter=filter, horizon=False, **options)  # type: ignore[arg-type]
-    tracks = vt.track_detections(detections)
+    tracks = vt.track_detections(detections, offsets)
     return centre_location_error(tracks_to_rows(tracks), truth)
 
 
@@ -180,15 +197,16 @@ def _unit(
         crf=crf,
     )
     detector = ClassicalShipDetector(polarity=polarity)  # type: ignore[arg-type]
-    dets = detect_video(res.video, VisualTracker(detector=detector, fps=fps))
+    offsets: list[np.ndarray] = []
+    dets = detect_video(res.video, VisualTracker(detector=detector, fps=fps), offsets)
     truth = read_truth(res.truth)
     rows: list[tuple[str, float | None, float, float, float]] = []
     for est in FILTERS:
-        c = track_case(dets, truth, est)
+        c = track_case(dets, truth, est, offsets)
         rows.append((est, None, c.mean_px, c.mean_percent, c.precision))
     if name == SWEEP_CASE:
         for a in orders:
-            c = track_case(dets, truth, "afkf", order=a)
+            c = track_case(dets, truth, "afkf", offsets, order=a)
             rows.append(("afkf", a, c.mean_px, c.mean_percent, c.precision))
     return {"run": r, "case": name, "crf": crf, "polarity": polarity, "rows": rows}
 

@@ -18,6 +18,12 @@ Issue 6, "Visual tracking"; ALGORITHMS.md §1.3–1.5. Per frame:
 3. confirmed tracks are reported, also while they coast on their prediction through a
    short occlusion or missed detections (up to ``delete_after`` frames).
 
+With ``motion`` (default) a moving camera's image shift is taken out first
+(:class:`~seawatch.vision.motion.CameraMotion`, measured on each frame where its horizon
+is found): the tracker filters the boxes in the first frame's coordinates (pixel minus
+the accumulated shift) and reports them in the frame's own; a fixed camera accumulates no
+shift and is tracked as without it.
+
 The water-line pixel of a track is its box centre plus a smoothed offset from the box
 centre to the detector's water-line point (the bottom-centre of the box until a
 detection gives one).
@@ -28,6 +34,7 @@ px, px, px, px, frames]; ``x, y`` is the box's top-left corner.
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Iterable, Iterator, Sequence
 from typing import Any, Literal
 
@@ -42,6 +49,7 @@ from seawatch.filters import (
 )
 from seawatch.tracking.mtt import MultiTargetTracker, TrackStates
 from seawatch.vision.detect import ClassicalShipDetector, Detections
+from seawatch.vision.motion import CameraMotion
 
 __all__ = ["DEFAULT_ORDER", "FILTERS", "TRACK_COLUMNS", "VisualTracker", "tracks_to_rows"]
 
@@ -132,6 +140,9 @@ class VisualTracker:
             in front); its water-line offset is then not updated.
         min_score: detections with a lower score are ignored.
         horizon: estimate the horizon per frame and give it to the detector (sea region).
+        motion: camera-motion compensation (module docstring): a panning or yawing
+            camera's frame-to-frame shift is measured in :meth:`stream` and :meth:`step`
+            (not for precomputed detections given to :meth:`update` alone).
         fps: frame rate used when frames come without times [1/s].
         filter_options: further keyword arguments of the AFKF/FKF (``rule``, ``gain``,
             ``window``, ``g_max``, ``delta``).
@@ -161,6 +172,7 @@ class VisualTracker:
         occlusion: bool = True,
         min_score: float = 0.0,
         horizon: bool = True,
+        motion: bool = True,
         fps: float = 25.0,
         filter_options: dict[str, Any] | None = None,
     ) -> None:
@@ -175,6 +187,7 @@ class VisualTracker:
         self.min_score = in_range("min_score", min_score, 0.0, 1.0)
         self.fps = positive("fps", fps)
         self.use_horizon = bool(horizon)
+        self._motion = CameraMotion() if motion else None
         opts = dict(filter_options or {})
         if filter == "kf":
             if opts:
@@ -210,6 +223,7 @@ class VisualTracker:
         self.mtt.reset()
         self._offsets: dict[int, FloatArray] = {}
         self._frame = 0
+        self._restart_motion()
         self._horizon: Any = None
         self.last_horizon: Any = None
         """The horizon (:class:`~seawatch.vision.horizon.HorizonEstimate`) of the last
@@ -227,6 +241,27 @@ class VisualTracker:
         tracks' pixels are another grid's); new tracks continue the ids."""
         self.mtt.reset(keep_ids=True)
         self._offsets.clear()
+
+    def _restart_motion(self) -> None:
+        self._shifts: deque[FloatArray] = deque()  # offsets measured, not yet tracked
+        self.camera_offset = np.zeros(2)
+        """The accumulated camera shift (x, y) [px] of the last frame tracked
+        (:class:`~seawatch.vision.motion.CameraMotion`; 0 for a fixed camera)."""
+        if self._motion is not None:
+            self._motion.reset()
+
+    def next_offset(self) -> FloatArray:
+        """The camera offset (x, y) [px] measured for the next frame to track, taken from
+        the queue :meth:`stream` fills (so that precomputed detections can be tracked
+        with it later: :meth:`track_detections`); the last one when none is waiting."""
+        if self._shifts:
+            self.camera_offset = self._shifts.popleft()
+        return self.camera_offset
+
+    def _measure_motion(self, image: ArrayLike, horizon: Any) -> None:
+        """Measure the next frame's camera shift (frame order) for :meth:`update`."""
+        if self._motion is not None:
+            self._shifts.append(self._motion.update(image, horizon))
 
     # ------------------------------------------------------------------ per frame
     def horizon(self, image: ArrayLike, time: float | None = None) -> Any:
@@ -253,25 +288,40 @@ class VisualTracker:
             det = self.detector(image)
         return _detection_rows(det)
 
-    def update(self, detections: Detections | ArrayLike | None) -> FloatArray:
+    def update(
+        self, detections: Detections | ArrayLike | None, *, offset: ArrayLike | None = None
+    ) -> FloatArray:
         """Track one frame's detections (steps 2–3); returns the confirmed tracks.
 
         Args:
             detections: :class:`Detections`, or boxes (k, 4) ``x, y, w, h`` [px], (k, 5)
                 with a score or (k, 7) with the water-line point; None: no detection.
+            offset: the frame's accumulated camera shift (x, y) [px]; default: the one
+                :meth:`stream` or :meth:`step` measured for this frame, else the last.
 
         Returns:
             (n, 8) float array of :data:`TRACK_COLUMNS`, rows in order of track id.
         """
         rows = _detection_rows(detections)
         rows = rows[rows[:, 4] >= self.min_score]
+        if offset is None:
+            off = self.next_offset()
+        else:
+            off = self.camera_offset = as_float_array("offset", offset).reshape(2)
+        rows[:, 0:2] -= off  # into the first frame's coordinates
+        rows[:, 5:7] -= off
         states = self.mtt.step(rows[:, :4] if rows.shape[0] else None, float(self._frame))
         self._frame += 1
-        return self._rows(states, rows)
+        out = self._rows(states, rows)
+        out[:, 1:3] += off  # back into this frame's pixels
+        out[:, 5:7] += off
+        return out
 
     def step(self, image: ArrayLike, time: float | None = None) -> FloatArray:
         """Detect and track one frame; the confirmed tracks (:meth:`update`)."""
-        return self.update(self.detect(image, time))
+        detections = self.detect(image, time)
+        self._measure_motion(image, self.last_horizon)
+        return self.update(detections)
 
     def stream(
         self, frames: Iterable[Any], *, ahead: bool = True
@@ -305,6 +355,7 @@ class VisualTracker:
         def horizon(fr: Any) -> tuple[Any, Any, Any]:
             image = getattr(fr, "image", fr)
             hz = self.horizon(image, getattr(fr, "time", None))
+            self._measure_motion(image, hz)
             # a detector that can prepare a frame apart (the classical one: its working
             # band) does so here, which balances the two threads
             return fr, hz, prepare(image, horizon=hz) if split else None  # type: ignore[misc]
@@ -351,12 +402,22 @@ class VisualTracker:
             out.append(self.update(det))
         return out
 
-    def track_detections(self, detections: Sequence[Any]) -> list[FloatArray]:
+    def track_detections(
+        self, detections: Sequence[Any], offsets: Sequence[ArrayLike] | None = None
+    ) -> list[FloatArray]:
         """Per-frame confirmed tracks of precomputed per-frame detections (no detector).
 
-        Lets several filters run on the very same detections (the ship-video scenario).
+        Lets several filters run on the very same detections (the ship-video scenario);
+        ``offsets``: the frames' camera offsets (:meth:`next_offset` while they were
+        detected); None: a fixed camera.
         """
-        return [self.update(d) for d in detections]
+        if offsets is None:
+            return [self.update(d, offset=(0.0, 0.0)) for d in detections]
+        if len(offsets) != len(detections):
+            raise ValueError(
+                f"offsets: expected one per frame ({len(detections)}), got {len(offsets)}"
+            )
+        return [self.update(d, offset=o) for d, o in zip(detections, offsets, strict=True)]
 
     # ------------------------------------------------------------------ output
     def _rows(self, st: TrackStates, det: FloatArray) -> FloatArray:
