@@ -35,14 +35,19 @@ vertical shift took uav-sea's EKF position error from 20.7 to 23.6 m and range-1
 bends the horizon, 8.3 → 9.9 % CLE); the horizontal shift alone, 20.7 and 31.6 m.
 
 Gate: a fixed camera's frames still register at shifts of a tenth of a pixel (clouds,
-compression), and adding that noise up would wander the tracks. The offset therefore
-grows only while the camera moves: while the mean shift over the last ``window`` frames
-is at least ``gate_px``, and by frames whose phase-correlation peak is at least
-``min_response``: 0.7–1.0 on the day skies of the rendered cases and moving-platform
-clips, 0.16 (median) on the night case's grain, whose weak peaks fall anywhere (±20 px;
-with 0.1 its fixed camera wandered 175 px in 8 s and its CLE went 1.19 → 12.8 %). A
-cut, a blank frame or a clear sky gives no peak. On a fixed
-camera the offset stays 0 and the tracker is exactly the uncompensated one.
+compression), now and then at a lone peak of ±10 px (sensor noise on lossless footage),
+and adding either up would wander the tracks. The offset therefore grows only while the
+camera moves. A pan starts when the median shift of the last ``window`` frames is at
+least ``gate_px`` (not before over half of ``window`` frames are measured: the first
+shift of the lossless renders, 0.9 px, would have started one), and goes on while the mean size of
+their shifts is at least half of it (through the turns of a pan to and fro). A shift
+further than :data:`_JUMP_PX` from the window's median is replaced by that median (a pan
+changes smoothly). Only frames whose phase-correlation peak is at least
+``min_response`` are measured: 0.7–1.0 on the day skies of the rendered cases and
+moving-platform clips, 0.16 (median) on the night case's grain, whose weak peaks fall
+anywhere (±20 px; with 0.1 its fixed camera wandered 175 px in 8 s and its CLE went
+1.19 → 12.8 %). A cut, a blank frame or a clear sky gives no peak. On a fixed camera
+the offset stays 0 and the tracker is exactly the uncompensated one.
 """
 
 from __future__ import annotations
@@ -61,6 +66,7 @@ __all__ = ["MIN_SKY", "CameraMotion"]
 MIN_SKY = 0.08
 """Least part of the frame height above the horizon (less its margin) to measure on."""
 _MARGIN = 0.02  # [of the height] left out above the horizon: ships' upper works
+_JUMP_PX = 2.0  # [px a frame] farthest a pan's shift lies from the window's median
 
 
 class CameraMotion:
@@ -69,8 +75,9 @@ class CameraMotion:
     Args:
         width: frames are downscaled by the whole factor that keeps them at least this
             wide [px] before the correlation.
-        window: frames over which the mean shift decides whether the camera moves.
-        gate_px: least mean shift [px per frame] of a moving camera.
+        window: frames whose shifts decide whether the camera moves.
+        gate_px: least median shift [px per frame] that starts a pan (half of it, as
+            the mean shift size, keeps it going).
         min_response: least phase-correlation peak of a shift that is used (0–1).
 
     Attributes:
@@ -100,7 +107,8 @@ class CameraMotion:
         self.moving = False
         self._prev: FloatArray | None = None
         self._prev_shape: tuple[int, ...] | None = None
-        self._lengths: deque[float] = deque(maxlen=self.window)
+        self._shifts: deque[float] = deque(maxlen=self.window)  # as measured
+        self._steps: deque[float] = deque(maxlen=self.window)  # odd peaks replaced
 
     def update(self, image: ArrayLike, horizon: Any = None) -> FloatArray:
         """Measure the next frame (in frame order) and return the offset (x, y) [px].
@@ -117,7 +125,8 @@ class CameraMotion:
         self._prev, self._prev_shape = band, img.shape
         self.shift = np.zeros(2)
         if prev is None or prev_shape != img.shape:
-            self._lengths.clear()
+            self._shifts.clear()
+            self._steps.clear()
             self.moving = False
             return self.offset.copy()
         rows = min(band.shape[0], prev.shape[0])
@@ -125,10 +134,19 @@ class CameraMotion:
             a, b = prev[:rows], band[:rows]
             hann = cv2.createHanningWindow(a.shape[::-1], cv2.CV_32F)  # 0.1 ms
             self.shift[0] = self._register(a, b, hann) * k
-        self._lengths.append(abs(float(self.shift[0])))
-        self.moving = float(np.mean(self._lengths)) >= self.gate_px
+        step = float(self.shift[0])
+        self._shifts.append(step)
+        typical = float(np.median(self._shifts))
+        if abs(step - typical) > _JUMP_PX:  # an odd peak, no pan's change: the pan goes on
+            step = typical
+        self._steps.append(step)
+        if self.moving:  # a pan goes on while its steps are not small (through its turns)
+            self.moving = float(np.mean(np.abs(self._steps))) >= 0.5 * self.gate_px
+        else:  # and starts when most of the window's shifts say so, at least half of it
+            enough = 2 * len(self._shifts) > self.window
+            self.moving = enough and abs(typical) >= self.gate_px
         if self.moving:
-            self.offset = self.offset + self.shift
+            self.offset = self.offset + np.array([step, 0.0])
         return self.offset.copy()
 
     def _register(self, a: FloatArray, b: FloatArray, hann: FloatArray) -> float:
