@@ -59,6 +59,32 @@ ReconnectOption = Annotated[
 ]
 
 
+def open_reader(
+    source: str,
+    *,
+    step: int,
+    start: float,
+    end: float | None,
+    max_frames: int | None,
+    fps: float | None,
+    reconnect: int,
+) -> Any:
+    """The :class:`~seawatch.io.video.VideoReader` of a command's source and frame
+    options (``--end`` checked against ``--start`` first)."""
+    from seawatch.io.video import VideoReader
+
+    check_span(start, end)
+    return VideoReader(
+        source,
+        step=step,
+        start=start,
+        end=end,
+        max_frames=max_frames,
+        fps=fps,
+        reconnect=reconnect,
+    )
+
+
 def check_span(start: float, end: float | None, first: str = "--start") -> None:
     """:class:`BadInput` naming ``--end`` unless it is after ``first`` (or absent)."""
     if end is not None and end <= start:

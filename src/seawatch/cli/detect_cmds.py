@@ -44,6 +44,7 @@ from seawatch.cli._common import (
     err,
     exit_codes,
     frame_records,
+    open_reader,
     warnings_to_stderr,
 )
 
@@ -165,7 +166,6 @@ def detect(
 
     Example: [cyan]seawatch detect clip.mp4 --json -o boxes.csv[/]
     """
-    from seawatch.io.video import VideoReader
     from seawatch.vision.external import make_detector
 
     with exit_codes(), warnings_to_stderr():
@@ -173,15 +173,10 @@ def detect(
         detector = make_detector(
             model, threshold=threshold, polarity=polarity, temporal=temporal, mask=mask
         )
-        reader = VideoReader(
-            source,
-            step=step,
-            start=start,
-            end=end,
-            max_frames=max_frames,
-            fps=fps,
+        reader = open_reader(
+            source, step=step, start=start, end=end, max_frames=max_frames, fps=fps,
             reconnect=reconnect,
-        )
+        )  # fmt: skip
         horizon_of = _horizon_source(reader, use_horizon)
         records, failure = frame_records(
             reader,

@@ -38,11 +38,11 @@ from seawatch.cli._common import (
     SourceArgument,
     StartOption,
     StepOption,
-    check_span,
     emit_json,
     err,
     exit_codes,
     frame_records,
+    open_reader,
     warnings_to_stderr,
 )
 
@@ -112,20 +112,13 @@ def horizon(
 
     Example: [cyan]seawatch horizon clip.mp4 --json -o horizon.csv[/]
     """
-    from seawatch.io.video import VideoReader
     from seawatch.vision.horizon import HorizonTracker, detect_horizon
 
     with exit_codes(), warnings_to_stderr():
-        check_span(start, end)
-        reader = VideoReader(
-            source,
-            step=step,
-            start=start,
-            end=end,
-            max_frames=max_frames,
-            fps=fps,
+        reader = open_reader(
+            source, step=step, start=start, end=end, max_frames=max_frames, fps=fps,
             reconnect=reconnect,
-        )
+        )  # fmt: skip
         use_tracker = (reader.kind not in ("folder", "image")) if smooth is None else smooth
         tracker = HorizonTracker(max_tilt_deg=max_tilt, fps=reader.fps or 25.0)
 
