@@ -101,7 +101,7 @@ class CameraMotion:
         self.reset()
 
     def reset(self) -> None:
-        """Forget the previous frame and the offset (a new video, a size change)."""
+        """Forget the previous frame and the offset (a new video)."""
         self.offset = np.zeros(2)
         self.shift = np.zeros(2)
         self.moving = False
