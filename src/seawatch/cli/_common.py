@@ -174,15 +174,14 @@ def frame_records(
     output: Path | None,
     columns: Sequence[str],
     csv_rows: Callable[[dict[str, Any]], list[list[str]]],
-    total: int | None,
 ) -> tuple[list[dict[str, Any]], Exception | None]:
     """Run ``process(frame) -> record`` over a :class:`~seawatch.io.video.VideoReader`.
 
     Shared loop of the per-frame commands (``horizon``, ``detect``): a progress bar on
-    stderr, the records kept in memory, ``csv_rows(record)`` appended to ``output`` and
-    flushed frame by frame. A source that fails mid-stream ends the loop and is returned
-    as the failure with the frames before it kept; a failure before the first frame is
-    raised (bad input).
+    stderr (out of the reader's ``expected_frames``), the records kept in memory,
+    ``csv_rows(record)`` appended to ``output`` and flushed frame by frame. A source that
+    fails mid-stream ends the loop and is returned as the failure with the frames before
+    it kept; a failure before the first frame is raised (bad input).
     """
     from seawatch.io.video import VideoError
 
@@ -191,7 +190,7 @@ def frame_records(
     sink, writer = open_csv(output, columns)
     try:
         with progress_bar() as bar:
-            task = bar.add_task(label, total=total)
+            task = bar.add_task(label, total=reader.expected_frames)
             try:
                 for frame in reader:
                     rec = process(frame)
@@ -208,6 +207,16 @@ def frame_records(
         if sink is not None:
             sink.close()
     return records, failure
+
+
+def reader_notes(reader: Any, output: Path | None) -> str:
+    """The end of a per-frame command's summary line: the reader's corrupt frames skipped
+    and images with NaN/inf pixels filled, and the CSV written (empty when none)."""
+    return (
+        (f", {reader.skipped} corrupt frame(s) skipped" if reader.skipped else "")
+        + (f", {reader.filled} with NaN/inf pixels filled" if reader.filled else "")
+        + (f"; wrote {output}" if output is not None else "")
+    )
 
 
 def progress_bar() -> Progress:

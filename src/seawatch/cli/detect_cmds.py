@@ -45,6 +45,7 @@ from seawatch.cli._common import (
     exit_codes,
     frame_records,
     open_reader,
+    reader_notes,
     warnings_to_stderr,
 )
 
@@ -185,15 +186,9 @@ def detect(
             output=output,
             columns=CSV_COLUMNS,
             csv_rows=_csv_rows,
-            total=reader.expected_frames,
         )
         n_boxes = sum(len(rec["boxes"]) for rec in records)
-        err.print(
-            f"{len(records)} frame(s), {n_boxes} box(es)"
-            + (f", {reader.skipped} corrupt frame(s) skipped" if reader.skipped else "")
-            + (f", {reader.filled} with NaN/inf pixels filled" if reader.filled else "")
-            + (f"; wrote {output}" if output is not None else "")
-        )
+        err.print(f"{len(records)} frame(s), {n_boxes} box(es)" + reader_notes(reader, output))
         if json_out:
             doc: dict[str, Any] = {"frames": records}
             if failure is not None:

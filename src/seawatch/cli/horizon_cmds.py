@@ -43,6 +43,7 @@ from seawatch.cli._common import (
     exit_codes,
     frame_records,
     open_reader,
+    reader_notes,
     warnings_to_stderr,
 )
 
@@ -134,14 +135,10 @@ def horizon(
             output=output,
             columns=CSV_COLUMNS,
             csv_rows=lambda rec: [_csv_row(rec)],
-            total=reader.expected_frames,
         )
         found = sum(r["found"] for r in records)
         err.print(
-            f"{len(records)} frame(s), horizon found in {found}"
-            + (f", {reader.skipped} corrupt frame(s) skipped" if reader.skipped else "")
-            + (f", {reader.filled} with NaN/inf pixels filled" if reader.filled else "")
-            + (f"; wrote {output}" if output is not None else "")
+            f"{len(records)} frame(s), horizon found in {found}" + reader_notes(reader, output)
         )
         if json_out:
             doc: dict[str, Any] = {"frames": records}
