@@ -658,6 +658,31 @@ def test_occlusion_a_wake_speck_on_a_ship_does_not_freeze_the_ship_s_size():
     assert st.boxes[st.ids == 1, 3][0] == pytest.approx(h - 2.0 * 0.7 / 0.3, abs=0.5)
 
 
+@pytest.mark.parametrize(("seen", "held"), [(30, True), (10, False)])
+def test_occlusion_a_settled_ship_keeps_its_height_when_its_box_rises(seen, held):
+    """A lone ship (40 × 10 px, 1 px/frame) seen alone for ``seen`` frames, then boxed
+    for 30 frames with something behind it that shows 8 px above its top (a ship
+    beyond it, a coast: the box 40 × 18 px with the same water line). A track with 25
+    or more detections keeps its height and is measured by its water line and its
+    remembered height: its centre stays on the ship to 0.05 px (crossing case, session
+    15: the ferry's box took in the container ship behind it, 4.75 → 2.41 % of its
+    diagonal). A younger track's height may still be wrong (a ship entering the frame),
+    so it takes the box, as the tracker without occlusion handling does (centre 4 px
+    high at the end)."""
+    trk = _tracker(confirm_m=1, confirm_n=1, occlusion=True, overlap_gate=0.5)
+    for k in range(seen + 30):
+        x, behind = 100.0 + k, 8.0 if k >= seen else 0.0
+        st = trk.step(np.array([[x, 200.0 - behind, 40.0, 10.0 + behind]]))
+        assert st.ids.tolist() == [1]
+    if held:
+        assert st.states[0, 1] == pytest.approx(205.0, abs=0.05)  # 200 + 10 / 2
+        assert st.boxes[0, 3] == pytest.approx(10.0, abs=1e-6)
+        assert st.anchored[0]
+    else:
+        assert st.states[0, 1] == pytest.approx(201.0, abs=0.3)  # 192 + 18 / 2
+        assert st.boxes[0, 3] == pytest.approx(18.0, abs=0.01)
+
+
 def test_occlusion_with_degenerate_boxes_keeps_finite_states():
     """Zero-width and zero-height boxes beside and inside a ship's box (a detector's
     degenerate output) with the occlusion handling on: every state stays finite and

@@ -32,7 +32,10 @@ image (pixels) or as points on the sea (metres). One scan:
    ships with one centre each takes the box of its own size; a track overlapping another
    (their predicted boxes, widened by the tolerance, overlap) also takes its edge of a
    merged box that went to the other, and is not restarted on a re-segmented box; a box
-   that covers a third of two such tracks starts no track of its own.
+   that covers a third of two such tracks starts no track of its own. A track with
+   25 detections or more (its height settled) whose box keeps its water line but whose
+   top rises above the track's by more than twice the tolerance has something behind
+   the ship in its box (a ship beyond it, a coast): its top edge is blocked too.
 5. **Manage tracks**: an unassigned detection starts a *tentative* track
    (``x0 = [z, 0, 0]``, ``P0 = diag(σ_z², σ_z², σ_v0², σ_v0²)``); a tentative track is
    *confirmed* once it has M detections among its last N scans (M-of-N, counting its
@@ -90,6 +93,9 @@ ships passing in front of it: tens of times)."""
 _EDGE_TOL = 0.15
 """Occlusion handling: a box edge within this fraction of a track's size (at least σ_z)
 of a span or an extent counts as on it (:meth:`MultiTargetTracker._tolerance`)."""
+_SETTLED_HITS = 25
+"""Occlusion handling: detections after which a confirmed track's height is its ship's
+(a top that then rises while the water line stays is something behind the ship)."""
 _UNGATED = 1.0e12  # cost of a pair outside the gate inside the assignment solver
 
 
@@ -512,7 +518,7 @@ class MultiTargetTracker:
         edges = None  # tracks measured by the free edges of their boxes
         self._anchored = None  # the gate's anchored centres of this scan (_anchor_pairs)
         self._S = None  # the predicted tracks' innovation covariances, once computed
-        if zs is not None and self.occlusion and np.count_nonzero(self._confirmed) >= 2:
+        if zs is not None and self.occlusion and self._confirmed.any():
             edges = self._confirmed.copy()
         if self.confirmed_first:
             rows, cols, r2, c2 = self._cascade(z, zs if boxes else None, zs, edges)
@@ -851,7 +857,11 @@ class MultiTargetTracker:
         track's size) inside the predicted span of another confirmed track that shares
         the track's span on the other axis and has at least a tenth of its area
         (:data:`_RESTART_GROWTH`; a wake or glint speck beside a ship blocks nothing):
-        it may be that ship's outline or the seam between two merged ships. With both
+        it may be that ship's outline or the seam between two merged ships; the top edge
+        of a track with :data:`_SETTLED_HITS` detections is blocked too where the box's
+        bottom is on the track's predicted one (within the tolerance) and its top lies
+        above the track's by more than twice the tolerance (something behind the
+        ship: a ship beyond it, a coast; its height is known by then). With both
         edges free the box is the track's own: its centre and size are measured. With
         one free edge the centre is that edge moved inwards by half the track's
         remembered size. With none, the box's centre where its extent agrees with that
@@ -885,6 +895,15 @@ class MultiTargetTracker:
             blocked_hi = np.any(shares & (olo - t <= hi[:, None]) & (hi[:, None] <= ohi + t), 1)
             lower = ohi[..., 1] > thi[..., 1] + 0.5 * self.sigma_z
             nearest = ~np.any(shares[..., 1] & lower, axis=1)
+        # a settled track whose box keeps its water line but rises above its top holds
+        # something behind the ship (a ship beyond it, a coast, a crane): its top is set
+        # aside as if another track's span blocked it
+        top, bottom_t = c[:, 1] - 0.5 * s[:, 1], c[:, 1] + 0.5 * s[:, 1]
+        blocked_lo[:, 1] |= (
+            (self._hits[rows] >= _SETTLED_HITS)
+            & (np.abs(hi[:, 1] - bottom_t) <= tol[:, 1])
+            & (top - lo[:, 1] > 2.0 * tol[:, 1])
+        )
         bottom = hi[:, 1] - 0.5 * s[:, 1]
         edge = np.full(dc.shape, np.nan)
         mine = nearest & (np.abs(bottom - c[:, 1]) <= tol[:, 1])
