@@ -361,10 +361,11 @@ def batch(
     ] = None,
     json_out: Annotated[bool, typer.Option("--json", help="Print the batch JSON.")] = False,
 ) -> None:
-    """Track many recordings, one Dask task each: OUT/<name>/ holds what [bold]seawatch
-    track[/] writes for each, OUT/batch.json every recording's summary or error (rewritten
-    as each ends). A failing recording is reported and the others go on (exit 1 if any
-    failed).
+    """Track many recordings in parallel, one Dask task each.
+
+    OUT/<name>/ holds what [bold]seawatch track[/] writes for each, OUT/batch.json every
+    recording's summary or error (rewritten as each ends). A failing recording is
+    reported and the others go on (exit 1 if any failed).
 
     Example: [cyan]seawatch batch day1/*.mp4 --camera mast.yaml --out out/day1 --workers 2[/]
     """

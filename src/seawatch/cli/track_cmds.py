@@ -161,8 +161,10 @@ def track(
         bool, typer.Option("--json", help="Print a JSON summary on stdout.")
     ] = False,
 ) -> None:
-    """Track the ships of a video and geo-reference them: tracks.csv, estimates.csv,
-    tracks.geojson, annotated.mp4 and report.html, written as they are produced.
+    """Track the ships of a video and geo-reference them.
+
+    Writes tracks.csv, estimates.csv, tracks.geojson, annotated.mp4 and report.html, each
+    as it is produced.
 
     Per frame: horizon, ship boxes and visual tracks; with [bold]--camera[/], each track's
     water-line pixel becomes azimuth and depression (attitude refined by the horizon),
