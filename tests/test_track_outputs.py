@@ -239,6 +239,54 @@ def test_a_track_coasts_three_seconds_whatever_the_step(tmp_path, gap, same_id):
     assert (before == after) == same_id
 
 
+def test_frames_lost_from_a_recording_are_coasted_over(tmp_path):
+    """A 25 frame/s recording of a boat (12 × 4 px, 5 px a frame) from which frames 40-44
+    were lost (their timestamps absent): the reader counts them, the track job predicts
+    the tracks over them (:meth:`VisualTracker.coast`) and the boat keeps one id (before,
+    the filters stepped one frame where six had passed: the box was 25 px from its
+    prediction, out of the gate, and a second track was born)."""
+    from fractions import Fraction
+
+    import av
+
+    from seawatch.vision.external import CallableDetector
+
+    lost = range(40, 45)
+    video = tmp_path / "lost.mp4"
+    container = av.open(str(video), "w")
+    stream = container.add_stream("libx264", rate=Fraction(25))
+    stream.width, stream.height, stream.pix_fmt = 480, 64, "yuv420p"
+    stream.codec_context.time_base = Fraction(1, 25)
+    for k in range(80):
+        if k in lost:
+            continue
+        img = np.full((64, 480), 128, np.uint8)
+        img[:16, :16] = 3 * k  # the frame number, coarse enough for the codec
+        frame = av.VideoFrame.from_ndarray(img, format="gray")
+        frame.pts, frame.time_base = k, Fraction(1, 25)
+        for packet in stream.encode(frame):
+            container.mux(packet)
+    for packet in stream.encode():
+        container.mux(packet)
+    container.close()
+
+    seen = []
+
+    def boat(image: np.ndarray) -> np.ndarray:
+        grey = image if image.ndim == 2 else image[..., 1]
+        k = round(float(grey[4:12, 4:12].mean()) / 3.0)
+        seen.append(k)
+        return np.array([[20.0 + 5.0 * k, 30.0, 12.0, 4.0]])
+
+    detector = CallableDetector(boat, refine_waterline=False)
+    out = tmp_path / "out"
+    track_video(video, out, detector=detector, annotate=False, report=False)
+    assert seen == [k for k in range(80) if k not in lost]  # the premise: frame numbers
+    rows = _rows(out / "tracks.csv")
+    assert {int(r["frame"]) for r in rows} >= {39, 45}  # indices keep the lost frames
+    assert len(_track_ids(rows, range(80))) == 1
+
+
 def test_target_above_the_horizon_gives_angles_without_range(clip, tmp_path):
     cam = load_camera(clip / "camera.yaml")
     # a camera file 2 deg more nose-up than the camera was: the ship's water line (0.9 deg

@@ -571,6 +571,7 @@ def track_video(
     frames_ahead = vtracker.stream(reader)
     size: tuple[int, int] | None = None
     last_time: float | None = None
+    last_index: int | None = None
 
     def restart(why: str) -> None:
         """New visual tracks (new ids) and no world tracks, with a note saying why."""
@@ -588,7 +589,10 @@ def track_video(
                     f"frame {frame.index}: {frame.time - last_time:.1f} s after the frame before "
                     "(a stream that dropped, a gap in the recording)"
                 )
-            last_time = float(frame.time)
+            elif last_index is not None:
+                # frames lost in between (counted by the reader): the tracks coast over them
+                vtracker.coast(max(0, (frame.index - last_index + step // 2) // step - 1))
+            last_time, last_index = float(frame.time), int(frame.index)
             shape = frame.image.shape
             if (shape[1], shape[0]) != size:
                 if size is not None:  # the stream's resolution changed (VideoReader warns)

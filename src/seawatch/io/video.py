@@ -625,8 +625,7 @@ class VideoReader:
         ctx = stream.codec_context
         if ctx.width and ctx.height:
             self._size = (int(ctx.width), int(ctx.height))
-        rate = stream.average_rate or stream.guessed_rate
-        self._rate = float(rate) if rate else None
+        self._rate = _nominal_rate(stream.average_rate, stream.guessed_rate)
         self._count = int(stream.frames) if stream.frames else None
         return container
 
@@ -941,6 +940,23 @@ class _Log:
                     VideoWarning,
                     stacklevel=4,
                 )
+
+
+def _nominal_rate(average: Any, guessed: Any) -> float | None:
+    """The stream's frame rate [frames/s]: its base rate (FFmpeg's r_frame_rate, PyAV's
+    ``guessed_rate``) where the average rate (frames over duration) is up to a third
+    below it — frames were lost from a constant-rate stream, so the average is lower —
+    else the average rate (a variable-rate stream whose base rate is a finer time grid;
+    interlaced video, whose base rate is often its field rate, twice the frame rate),
+    else whichever is known. None when neither is."""
+    avg = float(average) if average else 0.0
+    base = float(guessed) if guessed else 0.0
+    ok = [r for r in (avg, base) if math.isfinite(r) and r > 0.0]
+    if not ok:
+        return None
+    if avg > 0.0 and math.isfinite(base) and avg <= base < 1.5 * avg:
+        return base
+    return ok[0]
 
 
 def _why(exc: BaseException) -> str:

@@ -317,6 +317,15 @@ class VisualTracker:
         out[:, 5:7] += off
         return out
 
+    def coast(self, frames: int) -> None:
+        """Predict every track over ``frames`` frames lost before the next one (a stream
+        or recording that dropped them): empty scans at the last camera offset, so the
+        filters, whose model steps one frame at a time, keep their velocities per frame
+        and the missed frames count towards deletion."""
+        for _ in range(integer("frames", frames, 0)):
+            self.mtt.step(None, float(self._frame))
+            self._frame += 1
+
     def step(self, image: ArrayLike, time: float | None = None) -> FloatArray:
         """Detect and track one frame; the confirmed tracks (:meth:`update`)."""
         detections = self.detect(image, time)
