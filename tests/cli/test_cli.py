@@ -37,6 +37,40 @@ def test_every_sub_command_help_shows_an_example(command):
     assert "Example" in result.stdout and f"seawatch {command}" in result.stdout
 
 
+def _all_commands(group, path=()):
+    """(path, click command) of every leaf command under a click group."""
+    for name, cmd in sorted(group.commands.items()):
+        if hasattr(cmd, "commands"):
+            yield from _all_commands(cmd, (*path, name))
+        else:
+            yield (*path, name), cmd
+
+
+def test_help_text_keeps_its_units_and_one_line_summaries():
+    """Rich markup takes ``[s]``, ``[px]`` or ``[deg]`` for style tags and drops them:
+    no option's or command's help may lose a bracketed word (a unit) when rendered, and
+    every command's summary in ``seawatch --help`` is one line of the docstring, not
+    its source's line breaks (both seen in session 15: "Clip length ." for
+    "Clip length [s].", "estimates.csv,\n tracks.geojson")."""
+    import re
+
+    from rich.text import Text
+
+    root = typer.main.get_command(app)
+    tag = re.compile(r"\[/?(?:bold|cyan|yellow|red|dim|italic)(?: \w+)*\]|\[/\]")
+    checked = 0
+    for path, cmd in _all_commands(root):
+        texts = [p.help for p in cmd.params if getattr(p, "help", None)] + [cmd.help or ""]
+        for text in texts:
+            shown = Text.from_markup(text).plain
+            for word in re.findall(r"\[[^\]]*[a-zA-Z][^\]]*\]", tag.sub("", text)):
+                assert word.lstrip("\\") in shown, (path, word, shown)
+                checked += 1
+        summary = (cmd.help or "").split("\n\n")[0]
+        assert "\n" not in summary, (path, summary)
+    assert checked >= 10  # the units of synth, track, horizon and the time options
+
+
 def test_bench_filters_json_is_one_document_with_ratios_and_agreement():
     result = runner.invoke(app, ["bench", "filters", "--size", "2000", "--repeats", "1", "--json"])
     assert result.exit_code == 0, result.output

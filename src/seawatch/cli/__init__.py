@@ -7,6 +7,8 @@ input. See INTERFACES.md for the contract.
 
 from __future__ import annotations
 
+import inspect
+import re
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -417,6 +419,43 @@ app.command()(detect_cmds.detect)
 app.command()(sweep_cmds.sweep)
 app.command()(track_cmds.track)
 app.add_typer(synth_cmds.app, name="synth")
+
+
+_NOT_MARKUP = re.compile(r"(?<!\\)\[(?!/\]|/?(?:bold|cyan|yellow|red|dim|italic)\b)(?=[a-zA-Z#@/])")
+"""An opening bracket that Rich would read as a style tag but that is text: a unit such
+as [s], [px] or [deg] (the markup the help uses — bold, cyan, yellow, red, [/] — stays)."""
+
+
+def _literal(text: str) -> str:
+    """``text`` with its unit brackets escaped for Rich markup (idempotent)."""
+    return _NOT_MARKUP.sub(r"\\[", text)
+
+
+def _unwrapped(doc: str | None) -> str | None:
+    """A command's docstring with each paragraph on one line: Typer's rich mode keeps
+    the source's line breaks, which a terminal narrower than the source then breaks
+    again mid-line (paragraphs stay apart; a paragraph that starts with ``\b`` is
+    kept as written)."""
+    if not doc:
+        return doc
+    paragraphs = inspect.cleandoc(doc).split("\n\n")
+    text = "\n\n".join(p if p.startswith("\b") else " ".join(p.split("\n")) for p in paragraphs)
+    return _literal(text)
+
+
+def _tidy_help(typer_app: typer.Typer) -> None:
+    """Every command's help (and every sub-app's) set to its unwrapped docstring with
+    its unit brackets escaped, so that Rich prints them (it takes ``[s]``, ``[px]`` or
+    ``[deg]`` for style tags and drops them; option help strings escape their own)."""
+    for info in typer_app.registered_commands:
+        if info.help is None and info.callback is not None:
+            info.help = _unwrapped(info.callback.__doc__)
+    for group in typer_app.registered_groups:
+        if group.typer_instance is not None:
+            _tidy_help(group.typer_instance)
+
+
+_tidy_help(app)
 
 
 def main() -> None:

@@ -44,8 +44,10 @@ FpsOption = Annotated[
     float | None,
     typer.Option(help="Frame rate of an image folder (times = index / fps); default 1."),
 ]
-StartOption = Annotated[float, typer.Option(help="First time to process [s].", min=0.0)]
-EndOption = Annotated[float | None, typer.Option(help="Time to stop at [s] (exclusive).", min=0.0)]
+StartOption = Annotated[float, typer.Option(help="First time to process \\[s].", min=0.0)]
+EndOption = Annotated[
+    float | None, typer.Option(help="Time to stop at \\[s] (exclusive).", min=0.0)
+]
 MaxFramesOption = Annotated[
     int | None, typer.Option("--max-frames", help="Stop after this many frames.", min=1)
 ]

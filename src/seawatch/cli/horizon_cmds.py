@@ -102,7 +102,7 @@ def horizon(
     ] = None,
     max_tilt: Annotated[
         float,
-        typer.Option("--max-tilt", help="Largest tilt of the horizon [deg].", min=1.0, max=60.0),
+        typer.Option("--max-tilt", help="Largest tilt of the horizon \\[deg].", min=1.0, max=60.0),
     ] = 25.0,
 ) -> None:
     """Detect the sea horizon in every frame of a video, stream or image folder.

@@ -50,10 +50,10 @@ def ship_video(
         ),
     ],
     out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")],
-    duration: Annotated[float, typer.Option(help="Clip length [s].")] = 10.0,
+    duration: Annotated[float, typer.Option(help="Clip length \\[s].")] = 10.0,
     fps: Annotated[float, typer.Option(help="Frame rate [1/s].")] = 25.0,
-    width: Annotated[int, typer.Option(help="Image width [px] (even).")] = 1920,
-    height: Annotated[int, typer.Option(help="Image height [px] (even).")] = 1080,
+    width: Annotated[int, typer.Option(help="Image width \\[px] (even).")] = 1920,
+    height: Annotated[int, typer.Option(help="Image height \\[px] (even).")] = 1080,
     seed: Annotated[int, typer.Option(help="Random seed (waves, clouds, noise).")] = 0,
     crf: Annotated[
         int, typer.Option(help="libx264 quality: 0 (lossless) … 51; lower is better.")
@@ -61,11 +61,11 @@ def ship_video(
     pan_deg: Annotated[
         float,
         typer.Option(
-            help="Pan the camera to and fro about its heading by this amplitude [deg] "
+            help="Pan the camera to and fro about its heading by this amplitude \\[deg] "
             "(0: fixed camera)."
         ),
     ] = 0.0,
-    pan_period: Annotated[float, typer.Option(help="Period of the pan [s].")] = 10.0,
+    pan_period: Annotated[float, typer.Option(help="Period of the pan \\[s].")] = 10.0,
     json_out: Annotated[
         bool, typer.Option("--json", help="Print a JSON summary on stdout.")
     ] = False,
@@ -169,7 +169,7 @@ def ais(
             "clip's start without --camera)."
         ),
     ] = None,
-    duration: Annotated[float | None, typer.Option(help="Clip length [s] (default 30).")] = None,
+    duration: Annotated[float | None, typer.Option(help="Clip length \\[s] (default 30).")] = None,
     fps: Annotated[float | None, typer.Option(help="Frame rate [1/s] (default 10).")] = None,
     seed: Annotated[int, typer.Option(help="Random seed (waves, clouds, noise).")] = 0,
     lighting: Annotated[str, typer.Option(help="day, dusk or night (thermal-like).")] = "day",

@@ -139,14 +139,14 @@ def track(
     mask: MaskOption = None,
     temporal: TemporalOption = False,
     pixel_sigma: Annotated[
-        float, typer.Option(help="1-sigma of the water-line pixel [px].", min=0.01)
+        float, typer.Option(help="1-sigma of the water-line pixel \\[px].", min=0.01)
     ] = 1.0,
     step: StepOption = 1,
     max_frames: MaxFramesOption = None,
     begin: Annotated[
         float,
         typer.Option(
-            help="First video time to track [s from the video's start] (--start is the UTC "
+            help="First video time to track \\[s from the video's start] (--start is the UTC "
             "time of the video's frame 0).",
             min=0.0,
         ),
