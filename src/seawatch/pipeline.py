@@ -58,7 +58,7 @@ from seawatch.geometry.geodesy import north_east_to_geodetic
 from seawatch.io.track_table import TableWriter
 from seawatch.io.video import VideoReader
 from seawatch.tracking.world import ESTIMATORS, PlatformPose, WorldEstimates, WorldTracker
-from seawatch.vision.tracker import VisualTracker
+from seawatch.vision.tracker import VisualTracker, frames_lost
 
 __all__ = [
     "ESTIMATE_COLUMNS",
@@ -591,7 +591,7 @@ def track_video(
                 )
             elif last_index is not None:
                 # frames lost in between (counted by the reader): the tracks coast over them
-                vtracker.coast(max(0, (frame.index - last_index + step // 2) // step - 1))
+                vtracker.coast(frames_lost(frame.index, last_index, step))
             last_time, last_index = float(frame.time), int(frame.index)
             shape = frame.image.shape
             if (shape[1], shape[0]) != size:

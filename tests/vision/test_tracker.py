@@ -14,7 +14,7 @@ from seawatch.metrics.cle import centre_location_error
 from seawatch.scenarios.ship_video import detect_video, read_truth
 from seawatch.synth import render_case
 from seawatch.vision.detect import Detections
-from seawatch.vision.tracker import TRACK_COLUMNS, VisualTracker, tracks_to_rows
+from seawatch.vision.tracker import TRACK_COLUMNS, VisualTracker, frames_lost, tracks_to_rows
 
 
 def _crossing(T=80, gap=range(30, 38)):
@@ -78,6 +78,32 @@ def test_coast_over_lost_frames_keeps_the_track(name):
             assert 2 in ids
     with pytest.raises(ValueError, match="frames"):
         VisualTracker(horizon=False).coast(-1)
+
+
+def test_track_frames_coasts_over_frames_whose_index_skips():
+    """``track_frames`` on ``Frame`` objects whose indices skip 30-34 (lost from the
+    source): the same boat as above keeps one id, one output per frame given, and
+    :func:`frames_lost` rounds index gaps to whole decimation steps."""
+    from seawatch.io.video import Frame
+
+    lost = range(30, 35)
+    frames = []
+    for k in (k for k in range(40) if k not in lost):
+        img = np.zeros((8, 8), np.uint8)
+        img[0, 0] = k
+        frames.append(Frame(index=k, time=k / 25.0, image=img))
+
+    def boat(image, **_):
+        k = int(image[0, 0])
+        return np.array([[100.0 + 4.0 * k, 200.0, 10.0, 4.0]])
+
+    vt = VisualTracker(detector=boat, horizon=False, motion=False)
+    out = vt.track_frames(frames, ahead=False)
+    assert len(out) == len(frames)
+    assert {int(i) for t in out for i in t[:, 0]} == {1}
+    assert frames_lost(35, 29) == 5 and frames_lost(30, 29) == 0 and frames_lost(29, 30) == 0
+    assert frames_lost(10, 5, step=5) == 0 and frames_lost(16, 5, step=5) == 1
+    assert frames_lost(13, 5, step=5) == 1  # 8 frames: nearer two steps than one
 
 
 def test_waterline_defaults_to_box_bottom_centre():

@@ -51,7 +51,14 @@ from seawatch.tracking.mtt import MultiTargetTracker, TrackStates
 from seawatch.vision.detect import ClassicalShipDetector, Detections
 from seawatch.vision.motion import CameraMotion
 
-__all__ = ["DEFAULT_ORDER", "FILTERS", "TRACK_COLUMNS", "VisualTracker", "tracks_to_rows"]
+__all__ = [
+    "DEFAULT_ORDER",
+    "FILTERS",
+    "TRACK_COLUMNS",
+    "VisualTracker",
+    "frames_lost",
+    "tracks_to_rows",
+]
 
 TRACK_COLUMNS: tuple[str, ...] = ("id", "x", "y", "w", "h", "u_wl", "v_wl", "misses")
 """Columns of a per-frame track array: track id, box top-left x, y [px], width w and
@@ -402,11 +409,20 @@ class VisualTracker:
                 ``time`` feeds the horizon tracker), e.g. a ``VideoReader``.
             ahead: detect ahead in background threads (:meth:`stream`).
 
+        Frames lost in between (a ``Frame`` index that skips more than the source's
+        ``step``, e.g. a ``VideoReader``'s decimation) are coasted over (:meth:`coast`).
+
         Returns:
-            one (n_k, 8) array of :data:`TRACK_COLUMNS` per frame.
+            one (n_k, 8) array of :data:`TRACK_COLUMNS` per frame given.
         """
         out = []
-        for _, hz, det in self.stream(frames, ahead=ahead):
+        step = int(getattr(frames, "step", 1) or 1)
+        last: int | None = None
+        for fr, hz, det in self.stream(frames, ahead=ahead):
+            index = getattr(fr, "index", None)
+            if index is not None and last is not None:
+                self.coast(frames_lost(index, last, step))
+            last = index
             self.last_horizon = hz
             out.append(self.update(det))
         return out
@@ -462,6 +478,12 @@ class VisualTracker:
             out[r, 5:7] = centres[i] + off
             out[r, 7] = st.misses[i]
         return out
+
+
+def frames_lost(index: int, last_index: int, step: int = 1) -> int:
+    """Frames lost between two frames delivered ``step`` source frames apart, from their
+    source indices (rounded to whole steps; 0 when none or when the index went back)."""
+    return max(0, (int(index) - int(last_index) + step // 2) // step - 1)
 
 
 def tracks_to_rows(per_frame: Sequence[FloatArray]) -> FloatArray:
