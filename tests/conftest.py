@@ -74,3 +74,35 @@ class StreamServer:
 def stream_server() -> type[StreamServer]:
     """:class:`StreamServer`, to serve bytes over HTTP as a live source (real sockets)."""
     return StreamServer
+
+
+def _write_at(path, frames, fps: int = 25) -> None:
+    """Write ``(index, image)`` pairs (grey or BGR uint8) as an H.264 file whose frame
+    ``index`` has the timestamp ``index / fps``: indices left out are frames lost before
+    the file was written (a recorder or stream that dropped them)."""
+    from fractions import Fraction
+
+    import av
+    import numpy as np
+
+    frames = list(frames)
+    h, w = frames[0][1].shape[:2]
+    container = av.open(str(path), "w")
+    stream = container.add_stream("libx264", rate=Fraction(fps))
+    stream.width, stream.height, stream.pix_fmt = w, h, "yuv420p"
+    stream.codec_context.time_base = Fraction(1, fps)
+    for index, image in frames:
+        fmt = "gray" if np.ndim(image) == 2 else "bgr24"
+        frame = av.VideoFrame.from_ndarray(image, format=fmt)
+        frame.pts, frame.time_base = index, Fraction(1, fps)
+        for packet in stream.encode(frame):
+            container.mux(packet)
+    for packet in stream.encode():
+        container.mux(packet)
+    container.close()
+
+
+@pytest.fixture
+def write_at():
+    """:func:`_write_at`: a video file with frames missing from its timestamps."""
+    return _write_at

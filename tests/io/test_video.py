@@ -200,7 +200,9 @@ def test_bytes_overwritten_mid_file_skip_and_count_frames_without_failing(
         np.testing.assert_array_equal(f.image, clean[f.index].image)
 
 
-def test_frames_lost_before_encoding_keep_the_stream_rate_and_their_indices(tmp_path: Path):
+def test_frames_lost_before_encoding_keep_the_stream_rate_and_their_indices(
+    tmp_path: Path, write_at
+):
     """A 25 frames/s recording from which 12 of 40 frames were lost before it was written
     (a camera or recorder that dropped them: their timestamps are absent). Its average
     rate is 28 frames over 1.6 s, 17.5 frames/s; the reader takes the stream's base
@@ -209,20 +211,7 @@ def test_frames_lost_before_encoding_keep_the_stream_rate_and_their_indices(tmp_
     uncounted and the indices drifted from the timestamps)."""
     path = tmp_path / "dropped.mp4"
     lost = {5, 6, 7, 11, 17, 18, 23, 27, 28, 29, 30, 35}
-    container = av.open(str(path), "w")
-    stream = container.add_stream("libx264", rate=Fraction(25))
-    stream.width, stream.height, stream.pix_fmt = W, H, "yuv420p"
-    stream.codec_context.time_base = Fraction(1, 25)
-    for i in range(40):
-        if i in lost:
-            continue
-        frame = av.VideoFrame.from_ndarray(_pattern(i), format="bgr24")
-        frame.pts, frame.time_base = i, Fraction(1, 25)
-        for packet in stream.encode(frame):
-            container.mux(packet)
-    for packet in stream.encode():
-        container.mux(packet)
-    container.close()
+    write_at(path, ((i, _pattern(i)) for i in range(40) if i not in lost))
     with av.open(str(path)) as c:  # the premise: the average rate is the kept frames'
         assert float(c.streams.video[0].average_rate) < 20.0
     reader = VideoReader(path)
