@@ -776,7 +776,7 @@ class VideoReader:
                             "discontinuity",
                             f"timestamps jump from {last_t:.3f} s to {t:.3f} s",
                         )
-                self.skipped = max(state["decode_errors"], gap_missing)
+                self.skipped = cursor.skipped + max(state["decode_errors"], gap_missing)
                 state["index"] += 1 + missing
                 last_t = t
                 take, stop = self._select(t, kept)
@@ -951,12 +951,9 @@ def _nominal_rate(average: Any, guessed: Any) -> float | None:
     else whichever is known. None when neither is."""
     avg = float(average) if average else 0.0
     base = float(guessed) if guessed else 0.0
-    ok = [r for r in (avg, base) if math.isfinite(r) and r > 0.0]
-    if not ok:
-        return None
-    if avg > 0.0 and math.isfinite(base) and avg <= base < 1.5 * avg:
+    if 0.0 < avg <= base < 1.5 * avg:
         return base
-    return ok[0]
+    return next((r for r in (avg, base) if 0.0 < r < math.inf), None)
 
 
 def _why(exc: BaseException) -> str:
