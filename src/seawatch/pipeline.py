@@ -58,7 +58,7 @@ from seawatch.geometry.geodesy import north_east_to_geodetic
 from seawatch.io.track_table import TableWriter
 from seawatch.io.video import VideoReader
 from seawatch.tracking.world import ESTIMATORS, PlatformPose, WorldEstimates, WorldTracker
-from seawatch.vision.tracker import VisualTracker, frames_lost
+from seawatch.vision.tracker import VisualTracker
 
 __all__ = [
     "ESTIMATE_COLUMNS",
@@ -571,7 +571,6 @@ def track_video(
     frames_ahead = vtracker.stream(reader)
     size: tuple[int, int] | None = None
     last_time: float | None = None
-    last_index: int | None = None
 
     def restart(why: str) -> None:
         """New visual tracks (new ids) and no world tracks, with a note saying why."""
@@ -589,10 +588,9 @@ def track_video(
                     f"frame {frame.index}: {frame.time - last_time:.1f} s after the frame before "
                     "(a stream that dropped, a gap in the recording)"
                 )
-            elif last_index is not None:
-                # frames lost in between (counted by the reader): the tracks coast over them
-                vtracker.coast(frames_lost(frame.index, last_index, step))
-            last_time, last_index = float(frame.time), int(frame.index)
+            # frames lost in between (counted by the reader): the tracks coast over them
+            vtracker.coast_to(frame.index, step)
+            last_time = float(frame.time)
             shape = frame.image.shape
             if (shape[1], shape[0]) != size:
                 if size is not None:  # the stream's resolution changed (VideoReader warns)

@@ -230,6 +230,7 @@ class VisualTracker:
         self.mtt.reset()
         self._offsets: dict[int, FloatArray] = {}
         self._frame = 0
+        self._last_index: int | None = None  # source index of the last frame (coast_to)
         self._restart_motion()
         self._horizon: Any = None
         self.last_horizon: Any = None
@@ -328,10 +329,20 @@ class VisualTracker:
         """Predict every track over ``frames`` frames lost before the next one (a stream
         or recording that dropped them): empty scans at the last camera offset, so the
         filters, whose model steps one frame at a time, keep their velocities per frame
-        and the missed frames count towards deletion."""
+        and the missed frames count towards deletion (none once no track is left)."""
         for _ in range(integer("frames", frames, 0)):
+            if self.mtt.n_tracks == 0:
+                break
             self.mtt.step(None, float(self._frame))
             self._frame += 1
+
+    def coast_to(self, index: int, step: int = 1) -> None:
+        """Before the frame of source index ``index``: :meth:`coast` over the frames lost
+        since the last index given here (:func:`frames_lost`; ``step``: source frames
+        between two frames delivered), and remember ``index``."""
+        last, self._last_index = self._last_index, int(index)
+        if last is not None:
+            self.coast(frames_lost(index, last, step))
 
     def step(self, image: ArrayLike, time: float | None = None) -> FloatArray:
         """Detect and track one frame; the confirmed tracks (:meth:`update`)."""
@@ -410,19 +421,17 @@ class VisualTracker:
             ahead: detect ahead in background threads (:meth:`stream`).
 
         Frames lost in between (a ``Frame`` index that skips more than the source's
-        ``step``, e.g. a ``VideoReader``'s decimation) are coasted over (:meth:`coast`).
+        ``step``, e.g. a ``VideoReader``'s decimation) are coasted over (:meth:`coast_to`).
 
         Returns:
             one (n_k, 8) array of :data:`TRACK_COLUMNS` per frame given.
         """
         out = []
         step = int(getattr(frames, "step", 1) or 1)
-        last: int | None = None
         for fr, hz, det in self.stream(frames, ahead=ahead):
             index = getattr(fr, "index", None)
-            if index is not None and last is not None:
-                self.coast(frames_lost(index, last, step))
-            last = index
+            if index is not None:
+                self.coast_to(index, step)
             self.last_horizon = hz
             out.append(self.update(det))
         return out
