@@ -560,7 +560,6 @@ def track_video(
         ais_every = max(1, round(fps / step / AIS_RATE))
     video_out = None
     total = reader.expected_frames
-    frames = 0
     done: list[int] = []  # source indices of the frames tracked (scored with --truth)
     ids: set[int] = set()
     labels: dict[int, int | None] = {}
@@ -665,7 +664,7 @@ def track_video(
                     for j, row in enumerate(est_rows):
                         if shown[j % k]:
                             est_out.write(row)  # type: ignore[union-attr]
-                    if associator is not None and frames % ais_every == 0:
+                    if associator is not None and len(done) % ais_every == 0:
                         view = _view_wedge(cam, ppose)
                         vel = np.stack(
                             [best.speed * np.cos(best.course), best.speed * np.sin(best.course)], -1
@@ -699,13 +698,12 @@ def track_video(
                 video_out.write(
                     frame.image, records, horizon, time=t, frame=int(frame.index), fit=True
                 )
-            frames += 1
             done.append(int(frame.index))
             if progress is not None:
-                progress(frames, total)
+                progress(len(done), total)
     except KeyboardInterrupt:
         interrupted = True
-        note(f"interrupted after {frames} frames; outputs hold every frame done")
+        note(f"interrupted after {len(done)} frames; outputs hold every frame done")
     finally:
         frames_ahead.close()  # type: ignore[attr-defined]
         outputs = tracks_out.close()
@@ -732,7 +730,7 @@ def track_video(
             frames=done,  # a frame skipped by --step or --max-frames is no miss
         ).to_json()
     run = TrackRun(
-        frames=frames,
+        frames=len(done),
         rows=tracks_out.rows,
         tracks=len(ids),
         outputs=outputs,
