@@ -235,19 +235,9 @@ def test_truncated_file_keeps_the_frames_before_the_cut_with_a_warning(clip: Pat
     assert [f.index for f in frames[:5]] == list(range(5))
 
 
-def test_truncated_file_without_index_is_a_clear_error(tmp_path: Path):
+def test_truncated_file_without_index_is_a_clear_error(tmp_path: Path, write_at):
     path = tmp_path / "late_index.mp4"  # PyAV's default: moov atom at the end
-    container = av.open(str(path), "w")
-    stream = container.add_stream("libx264", rate=Fraction(25))
-    stream.width, stream.height, stream.pix_fmt = W, H, "yuv420p"
-    for i in range(10):
-        frame = av.VideoFrame.from_ndarray(_pattern(i), format="bgr24")
-        frame.pts = i
-        for packet in stream.encode(frame):
-            container.mux(packet)
-    for packet in stream.encode():
-        container.mux(packet)
-    container.close()
+    write_at(path, ((i, _pattern(i)) for i in range(10)))
     cut = tmp_path / "late_cut.mp4"
     cut.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
     with pytest.raises(VideoError, match=r"late_cut\.mp4"):
