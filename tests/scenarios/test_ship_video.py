@@ -50,7 +50,7 @@ def test_bad_arguments_raise():
 def test_dark_polarity_drops_the_glitters_tracks_in_the_lighting_case():
     """The lighting case faces a low sun: with the detector looking for dark ships only
     (``polarity="dark"``), no glitter track takes the distant boat's CLE (8 s, three
-    renderings: afkf 21.8 → 2.57 %, README); on 2 s here 10.5 → 1.96 % (afkf), with
+    renderings: afkf 14.5 → 2.57 %, README); on 2 s here 10.5 → 1.96 % (afkf), with
     the ordering afkf ≤ fkf ≤ kf (1.96, 1.96, 2.05 %), which the default misses (kf
     3.92 %)."""
     opts = {"cases": ["lighting"], "duration": 2.0}

@@ -724,6 +724,30 @@ def test_dark_hull_between_bright_glint_streaks_is_boxed_alone():
     assert not np.any(det.w > 60), det.boxes  # no box spans hull and glint
 
 
+def test_dark_hull_over_glint_streaks_is_not_merged_with_them():
+    """A dark hull (−60 grey levels, 50 × 7 px, with a superstructure) with bright glint
+    streaks (+60, 40 × 3 px) under it: one touching its water line and two more below
+    it, 6 px apart — looking into a low sun. A dark part above a bright one is no
+    ship's fragments (a pale superstructure sits on a dark hull, not under it): the
+    hull is boxed alone (within a pixel) and no box reaches from the hull down into the
+    streaks. Measured before (session 16): one 60 × 32 px box over hull and streaks,
+    the hull not boxed (the rendered lighting case, seed 1: 215 × 129 px)."""
+    rng = np.random.default_rng(78)
+    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
+    img = base.copy()
+    bright = float(np.median(base[195:245, 240:420])) + 60.0
+    t = box_ship(img, base, 330.0, 210.5, 50, 7, -60, sup=(0.4, 4))
+    for x0, x1, y0 in ((310.0, 350.0, 210.5), (300.0, 340.0, 219.5), (320.0, 360.0, 228.5)):
+        paint_polygon(img, [(x0, y0), (x1, y0), (x1, y0 + 3.0), (x0, y0 + 3.0)], bright)
+    img = as_u8(cv2.GaussianBlur(img, (0, 0), 0.7) + rng.normal(0, 2.0, img.shape))
+    det = ClassicalShipDetector()(img, horizon=hz)
+    found, _ = match(det, np.array([t]), tol=3.0)
+    assert found[0] >= 0, det.boxes
+    assert np.all(np.abs(det.boxes[found[0], :4] - t[:4]) <= 1.0), (det.boxes[found[0]], t)
+    spans = (det.y < t[1] + t[3]) & (det.y + det.h > t[1] + t[3] + 6.0)
+    assert not spans.any(), det.boxes  # no box from the hull down into the streaks
+
+
 @pytest.mark.parametrize("refine", REFINE)
 def test_rendered_footage_water_line_matches_truth_within_the_renderers_fill(tmp_path, refine):
     """Rendered H.264 footage (``seawatch.synth.render``): a 50 m ferry 800 m out and a
