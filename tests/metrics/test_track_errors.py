@@ -269,7 +269,8 @@ def test_bad_files_raise_value_error_naming_the_file(tmp_path: Path, truth: Path
         score_tracks(tmp_path / "nope.csv", truth)
     with pytest.raises(ValueError, match=r"truth .*missing\.csv"):
         score_tracks(tracks, tmp_path / "missing.csv")
-    no_col = _write(tmp_path / "t2.csv", _truth_rows(), ["frame", "object_id", "x", "y", "w", "h"])
+    no_col = _write(tmp_path / "t2.csv", _truth_rows(), ["frame", "object_id", "x", "y", "w", "h",
+                                                         "north_m"])  # fmt: skip
     with pytest.raises(ValueError, match=r"t2\.csv.*east_m"):
         score_tracks(tracks, no_col)
     bad = _as_tracks(_truth_rows())
@@ -293,6 +294,29 @@ def test_bad_files_raise_value_error_naming_the_file(tmp_path: Path, truth: Path
         score_tracks(tracks, truth, threshold=1.5)
     with pytest.raises(ValueError, match=r"tracks.*geo_east"):
         score_tracks(tracks, truth, positions={"g": ("geo_east", "geo_north")})
+
+
+def test_pixel_truth_without_positions_gives_the_pixel_scores_alone(
+    tmp_path: Path, truth: Path
+) -> None:
+    """Boxes annotated on a real clip (``frame``, ``object_id``, ``x``, ``y``, ``w``,
+    ``h``; no ``east_m``/``north_m``): the same matches, MOTA, IDF1, HOTA and CLE as
+    against the full truth, and no position errors (null in the JSON) instead of an
+    error."""
+    tracks = _as_tracks(_truth_rows())
+    for t in tracks[:8]:
+        t["x"] += 3.0
+    tracks = [t for t in tracks if not (t["track_id"] == 12 and t["frame"] > 6)]
+    pixels = _write(tmp_path / "boxes.csv", _truth_rows(), ["frame", "object_id", "x", "y", "w",
+                                                            "h"])  # fmt: skip
+    full, px = _score(tmp_path, truth, tracks), _score(tmp_path, pixels, tracks)
+    for name in ("cle_px", "mota", "idf1", "hota", "tp", "fp", "fn", "id_switches", "pairs"):
+        assert getattr(px, name) == getattr(full, name), name
+    assert full.rmse_position_m == 0.0 and math.isnan(px.rmse_position_m)
+    doc = px.to_json()
+    assert doc["rmse_position_m"] is None and doc["rmse_range_percent"] is None
+    assert doc["mota"] == pytest.approx(full.mota)
+    assert px.positions["tracks"].missing == px.pairs
 
 
 def test_ranges_of_a_moving_platform_are_taken_from_each_rows_camera(tmp_path: Path) -> None:

@@ -302,3 +302,32 @@ def test_fvessel_real_detections_keep_every_ship_with_few_ids():
     assert m.hota.hota > 0.65 and m.clear.mota > 0.82 and m.identity.idf1 > 0.88
     assert m.clear.id_switches <= 2 and np.unique(rows[:, 1]).size <= 9
     assert m.clear.fn <= 70  # of 1,709 truth boxes
+
+
+MARDCT = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "mardct_ir3"
+
+
+@pytest.mark.skipif(
+    not (MARDCT / "boxes.csv").is_file(),
+    reason=f"MarDCT ir-3 frames not found at {MARDCT} (shared data folder absent)",
+)
+def test_mardct_real_thermal_boat_is_tracked_to_a_pixel_and_a_half():
+    """The 88 real thermal MarDCT ir-3 frames (a small boat near a coastline, TIRSD's
+    box per frame; read in place), from pixels to tracks with VisualTracker's defaults:
+    the boat has a track in at least 95 % of the frames and the centre location error
+    (§1.6) is under 1.6 px. Measured (session 16, docs/results/detect/): coverage 97.7 %
+    (the first two frames, before confirmation), 1.35 px (afkf; fkf 1.45, kf 1.40), with
+    10.8 and 17.2 px in frames 14-15, where the boat's image motion drops from 17 px a
+    frame to almost none and its track coasts on."""
+    from seawatch.io.video import VideoReader
+
+    boxes = np.genfromtxt(MARDCT / "boxes.csv", delimiter=",", names=True, dtype=None)
+    order = np.argsort(boxes["frame"])
+    truth = np.column_stack([np.arange(order.size), np.ones(order.size)]
+                            + [boxes[k][order] for k in ("x", "y", "w", "h")])  # fmt: skip
+    vt = VisualTracker()
+    with VideoReader(MARDCT / "images", fps=25.0) as reader:
+        rows = tracks_to_rows(vt.track_frames(reader))
+    c = centre_location_error(rows, truth)
+    assert c.coverage >= 0.95, c.coverage
+    assert c.mean_px < 1.6, c.mean_px

@@ -110,7 +110,11 @@ def track(
         typer.Option(help="AIS to cross-check with: raw NMEA (!AIVDM) or decoded CSV."),
     ] = None,
     truth: Annotated[
-        Path | None, typer.Option(help="truth.csv of `seawatch synth`: score the run.")
+        Path | None,
+        typer.Option(
+            help="truth.csv of `seawatch synth`, or boxes annotated on a real clip "
+            "(CSV: frame, object_id, x, y, w, h; pixel scores only): score the run."
+        ),
     ] = None,
     start: Annotated[
         str | None,

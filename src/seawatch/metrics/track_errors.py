@@ -36,6 +36,10 @@ Errors over the matched pairs
   the signed mean relative range error (bias) — e.g. issue 7's "range error under 5 %
   at 1 km" is the 750–1250 m bin.
 
+Pixel truth: a truth table without ``east_m``/``north_m`` (boxes annotated on a real
+clip: ``frame``, ``object_id``, ``x``, ``y``, ``w``, ``h``) gives the box scores (MOTA,
+IDF1, HOTA, CLE) alone; the position errors are NaN (null in the JSON).
+
 Several estimators: ``positions`` maps an estimator name to the (east, north) column
 names of ``tracks.csv`` to score (default ``{"tracks": ("east_m", "north_m")}``; the
 first entry gives the headline numbers), and ``estimates`` names a long-form table with
@@ -487,8 +491,9 @@ def _position_errors(
     where: tuple[np.ndarray, np.ndarray, np.ndarray],
 ) -> PositionErrors:
     """Errors of estimates ``est`` (P, 2) (east, north) against ``truth`` (P, 2); ranges
-    from the camera foot point ``origin`` (P, 2) (east, north) of each pair [m]."""
-    ok = np.all(np.isfinite(est), axis=1)
+    from the camera foot point ``origin`` (P, 2) (east, north) of each pair [m]. A pair
+    without an estimate or a truth position is left out (``missing``)."""
+    ok = np.all(np.isfinite(est), axis=1) & np.all(np.isfinite(truth), axis=1)
     e, t = est[ok], truth[ok]
     c = origin[ok]
     err = np.hypot(*(e - t).T)
@@ -554,7 +559,9 @@ def score_tracks(
         tracks_csv: ``tracks.csv`` (columns ``frame``, ``track_id``, ``x``, ``y``, ``w``,
             ``h`` and the position columns of ``positions``).
         truth_csv: ``truth.csv`` of ``seawatch synth`` (``frame``, ``object_id``, ``x``,
-            ``y``, ``w``, ``h``, ``east_m``, ``north_m``).
+            ``y``, ``w``, ``h``, ``east_m``, ``north_m``); without ``east_m`` and
+            ``north_m`` (boxes annotated on a real clip) the pixel scores alone, the
+            position errors NaN.
         camera: a :class:`~seawatch.camera.PinholeCamera` or camera file giving the foot
             point of the ranges (its ``position`` [m]); None: ``camera.yaml`` beside the
             truth if present, else (0, 0).
@@ -597,8 +604,11 @@ def score_tracks(
     t_frame, t_id, t_box = _boxes("tracks", trk, "track_id")
     if truth.rows == 0:
         raise ValueError(f"truth {truth.path}: no rows (no object in view): nothing to score")
-    _require("truth", truth, ("east_m", "north_m"))
-    g_en = np.stack([_floats("truth", truth, "east_m"), _floats("truth", truth, "north_m")], -1)
+    if "east_m" in truth.columns or "north_m" in truth.columns:
+        _require("truth", truth, ("east_m", "north_m"))
+        g_en = np.stack([_floats("truth", truth, "east_m"), _floats("truth", truth, "north_m")], -1)
+    else:  # pixel truth (annotated boxes of a real clip): no position errors
+        g_en = np.full((truth.rows, 2), np.nan)
     wide: dict[str, FloatArray] = {}
     for name, (ce, cn) in pos_cols.items():
         _require("tracks", trk, (ce, cn))
