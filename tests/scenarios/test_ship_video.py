@@ -50,16 +50,17 @@ def test_bad_arguments_raise():
 def test_dark_polarity_drops_the_glitters_tracks_in_the_lighting_case():
     """The lighting case faces a low sun: with the detector looking for dark ships only
     (``polarity="dark"``), no glitter track takes the distant boat's CLE (8 s, three
-    renderings: afkf 14.5 → 2.57 %, README); on 2 s here 10.5 → 1.96 % (afkf), with
-    the ordering afkf ≤ fkf ≤ kf (1.96, 1.96, 2.05 %), which the default misses (kf
-    3.92 %)."""
+    renderings: afkf 9.14 → 2.57 %, README); on 2 s here 3.99 → 2.40 % (afkf), with
+    the ordering afkf ≤ fkf ≤ kf (2.40, 2.40, 2.47 %), which the default misses (fkf
+    4.07, kf 4.03 %). (Before session 16's detector changes, which drop most glitter
+    boxes with both polarities too, the default gave 10.5 % here.)"""
     opts = {"cases": ["lighting"], "duration": 2.0}
     both = run(**opts)
     dark = run(polarity="dark", **opts)
     assert dark.extra["polarity"] == "dark" and both.extra["polarity"] == "both"
     e_both = both.find("afkf", "cle_percent", case="lighting")["mean"]
     e_dark = dark.find("afkf", "cle_percent", case="lighting")["mean"]
-    assert e_dark < 0.5 * e_both, (e_dark, e_both)
+    assert e_dark < 0.75 * e_both, (e_dark, e_both)
     assert dark.extra["ordering"]["lighting"]
 
 

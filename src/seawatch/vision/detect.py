@@ -793,7 +793,10 @@ class ClassicalShipDetector:
        flat levels, the object is two ships, one in front of the
        other or side by side, each boxed with its own water line; detections that are a
        part of another (a superstructure boxed alone, two candidates of one ship) are
-       dropped (:func:`_distinct`).
+       dropped (:func:`_distinct`). With ``refine="mask"`` a bright candidate (of the
+       brightness polarity alone) is kept only if the flank refinement finds an object
+       in it too: glitter, the sun path's own structure running on beyond the flank
+       windows, is none (the mask refinement keeps the boxes).
     6. A box is kept if its water-line point lies on the sea (``sea_mask``, or on or
        below the horizon line with ``horizon_tolerance · H`` of slack; the box itself may
        rise above the horizon), its sides are ≥ ``min_size`` (1.5 px: the rendered lighting
@@ -962,7 +965,14 @@ class ClassicalShipDetector:
         out, polarity = [], []
         for c in cands:
             refine = self._refine if self.refine == "flank" else self._refine_mask
-            for x, y, w, h, u, v, area in refine(c, levels[c.level], fr):
+            objects = refine(c, levels[c.level], fr)
+            if objects and refine != self._refine and c.polarity == 1:
+                # a bright candidate must also stand out against a background of its own
+                # (:meth:`_refine`): a glitter streak is the sun path's structure
+                # running on beyond any window, a ship is not
+                if not self._refine(c, levels[c.level], fr):
+                    continue
+            for x, y, w, h, u, v, area in objects:
                 if (
                     min(w, h) < self.min_size
                     or w > self.max_size * W
