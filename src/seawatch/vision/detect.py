@@ -966,7 +966,7 @@ class ClassicalShipDetector:
         for c in cands:
             refine = self._refine if self.refine == "flank" else self._refine_mask
             objects = refine(c, levels[c.level], fr)
-            if objects and refine != self._refine and c.polarity == 1:
+            if objects and self.refine == "mask" and c.polarity == 1:
                 # a bright candidate must also stand out against a background of its own
                 # (:meth:`_refine`): a glitter streak is the sun path's structure
                 # running on beyond any window, a ship is not
