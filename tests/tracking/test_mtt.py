@@ -701,3 +701,33 @@ def test_occlusion_with_degenerate_boxes_keeps_finite_states():
         assert np.all(np.isfinite(st.states)) and np.all(np.isfinite(st.boxes))
     ship = np.flatnonzero(st.ids == 1)
     assert ship.size == 1 and st.states[ship[0], 0] == pytest.approx(134.0, abs=0.5)
+
+
+@pytest.mark.parametrize("in_front", [True, False])
+def test_occlusion_a_ship_emerging_from_behind_grows_to_its_box(in_front):
+    """Ship A (54 × 14 px, its water line at row 204) is hidden behind the nearer B
+    (56 × 20 px, water line 210) but for its left 20 px and slides out to the left at
+    1 px/frame: its box runs from its own left end to B's left edge and grows. A track
+    born on the short box is measured by the box once it is longer than the
+    remembered width (the ship is at least the box): its centre is the box's — off by
+    half the part still hidden, not by half of all but the first 20 px — and its width
+    follows. Where B is not in front (its water line on A's), a box that ends at B's
+    edge may be a bridge between the two, and A keeps its remembered width, measured by
+    its free left edge, until it is clear of B (crossing case, seed 0: the container
+    ship's track born on 19 px of 54 kept that width while it emerged, 17 px off)."""
+    trk = _tracker(confirm_m=1, confirm_n=1, occlusion=True, overlap_gate=0.5)
+    b_bottom = 210.0 if in_front else 204.0
+    b = [300.0, b_bottom - 20.0, 56.0, 20.0]
+    for k in range(45):
+        a_left = 280.0 - k
+        visible = min(54.0, 300.0 - a_left)
+        st = trk.step(np.array([[a_left, 190.0, visible, 14.0], b]))
+        a = st.ids == 1
+        err = a_left + 27.0 - st.states[a, 0][0]
+        if 5 <= k <= 33:  # emerging
+            hidden = 54.0 - visible
+            expected = 0.5 * hidden if in_front else 17.0
+            assert err == pytest.approx(expected, abs=0.05), (k, err)
+        if k >= 42:  # clear of B since frame 34
+            assert abs(err) < 0.3, (k, err)
+            assert st.boxes[a, 2][0] > 53.0

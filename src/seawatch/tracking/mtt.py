@@ -25,7 +25,11 @@ image (pixels) or as points on the sea (metres). One scan:
    (on an axis where the two tracks' spans on the other axis overlap; a track of under a
    tenth of its area blocks nothing). Both edges free: the box is the track's (centre
    and size measured). One free edge: the centre is that edge moved inwards by half the
-   track's remembered size, and the size is kept. No free edge: the box's centre if its
+   track's remembered size, and the size is kept — unless the box is wider than that
+   and its other edge stops at the near side of a ship in front (whose water line is
+   lower by more than the tolerance; the box reaching at most σ_z into its span): the
+   ship goes on behind that one, so it is at least its box, which is measured (a ship
+   coming out from behind another). No free edge: the box's centre if its
    extent agrees with the track's size; on the vertical axis the bottom edge (the water
    line) for the nearest of the overlapping ships if it agrees with its predicted one;
    else the pair is not used and the track coasts. Gating uses these centres, so of two
@@ -864,12 +868,17 @@ class MultiTargetTracker:
         ship: a ship beyond it, a coast; its height is known by then). With both
         edges free the box is the track's own: its centre and size are measured. With
         one free edge the centre is that edge moved inwards by half the track's
-        remembered size. With none, the box's centre where its extent agrees with that
-        size; on the vertical axis, else the bottom edge (the water line) if it agrees
-        with the predicted one and no other track's predicted bottom over the track's
-        columns is lower by more than σ_z / 2 (a nearer ship, whose water line the box's
-        bottom may be); else NaN: the box does not tell where the track is (two ships
-        crossing inside one box), and the pair is not used.
+        remembered size, unless the blocked edge stops at the near side of every ship
+        blocking it, each in front (its water line lower than the track's by more than
+        the tolerance; the box reaching at most σ_z into its span) and the box is wider
+        than the remembered width: the ship goes on behind them, so it is at least the
+        box, which is measured as with both edges free. With none, the box's centre
+        where its extent agrees with that size; on the vertical axis, else the bottom
+        edge (the water line) if it agrees with the predicted one and no other track's
+        predicted bottom over the track's columns is lower by more than σ_z / 2 (a
+        nearer ship, whose water line the box's bottom may be); else NaN: the box does
+        not tell where the track is (two ships crossing inside one box), and the pair
+        is not used.
 
         Hand-written: trackers of merged blobs (e.g. Haritaoglu et al., W4, 2000)
         measure an occluded object by its visible outer edge; no library offers it for
@@ -879,6 +888,8 @@ class MultiTargetTracker:
         tol = self._tolerance(s)
         blocked_lo = np.zeros(lo.shape, bool)
         blocked_hi = np.zeros(hi.shape, bool)
+        bound_lo = np.zeros(lo.shape, bool)  # the box is a lower bound of the ship's extent
+        bound_hi = np.zeros(hi.shape, bool)
         nearest = np.ones(rows.size, bool)  # no ship below the track's bottom over its span
         others = np.flatnonzero(self._confirmed)
         if others.size:
@@ -891,8 +902,17 @@ class MultiTargetTracker:
             area = np.prod(s, axis=1)[:, None]
             oarea = np.prod(self._size[others], axis=1)[None]
             shares &= (oarea * _RESTART_GROWTH > area)[..., None]  # not a speck on a ship
-            blocked_lo = np.any(shares & (olo - t <= lo[:, None]) & (lo[:, None] <= ohi + t), 1)
-            blocked_hi = np.any(shares & (olo - t <= hi[:, None]) & (hi[:, None] <= ohi + t), 1)
+            on_lo = shares & (olo - t <= lo[:, None]) & (lo[:, None] <= ohi + t)
+            on_hi = shares & (olo - t <= hi[:, None]) & (hi[:, None] <= ohi + t)
+            blocked_lo, blocked_hi = on_lo.any(axis=1), on_hi.any(axis=1)
+            # an edge that every span blocking it blocks from in front (its water line
+            # lower by more than the tolerance) at its near side (the box reaching at
+            # most σ_z into it): the ship goes on behind the other, it is at least the box
+            front = (ohi[..., 1] > thi[..., 1] + t[..., 1])[..., None]  # (P, k, 1)
+            into_lo = ohi - lo[:, None] > self.sigma_z
+            into_hi = hi[:, None] - olo > self.sigma_z
+            bound_lo = blocked_lo & ~np.any(on_lo & (~front | into_lo), 1)
+            bound_hi = blocked_hi & ~np.any(on_hi & (~front | into_hi), 1)
             lower = ohi[..., 1] > thi[..., 1] + 0.5 * self.sigma_z
             nearest = ~np.any(shares[..., 1] & lower, axis=1)
         # a settled track whose box keeps its water line but rises above its top holds
@@ -909,12 +929,17 @@ class MultiTargetTracker:
         mine = nearest & (np.abs(bottom - c[:, 1]) <= tol[:, 1])
         edge[:, 1] = np.where(mine, bottom, np.nan)
         stuck = np.where(np.abs(ds - s) <= tol, dc, edge)
+        # one free edge, the other bounding, and the box longer than the remembered
+        # width: a ship coming out from behind another is measured by its box
+        longer = (ds > s) & ((~blocked_lo & bound_hi) | (~blocked_hi & bound_lo))
+        longer[:, 1] = False  # heights: the water line rules (below)
+        free = (~blocked_lo & ~blocked_hi) | longer
         centre = np.where(
-            ~blocked_lo & ~blocked_hi,
+            free,
             dc,
             np.where(~blocked_lo, lo + 0.5 * s, np.where(~blocked_hi, hi - 0.5 * s, stuck)),
         )
-        return centre, ~blocked_lo & ~blocked_hi
+        return centre, free
 
     def _anchor_pairs(
         self, rows: NDArray[np.int64], cols: NDArray[np.int64], z: FloatArray, sizes: FloatArray
