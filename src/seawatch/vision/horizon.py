@@ -34,7 +34,9 @@ the colour channels on the same scale. Then:
    ``|P_s|`` at the line over its mean in the rows 3 … max(8, 6 % h) away on the quieter
    side (sea texture makes many similar parallel "lines", a horizon one).
 4. **Region test (sky/sea statistics).** For each strip, the mean feature vectors
-   (colour or luma, and texture ``|∇g|``, each in units of its 10–90 % spread) of a
+   (colour or luma, and texture ``|g_x| + |g_y − ḡ_y|``, ``ḡ_y`` the strip's mean of
+   that row: a straight edge across the strip, the line itself, is no texture; each
+   in units of its 10–90 % spread) of a
    band of 4 % of the height just above the line (A), one just below (B) and the next
    two bands below that (B₂) give ``r_s = ‖A − B‖ − ‖B − B₂‖``: the regions either side
    differ, and the region below continues without another boundary — the sea. A line
@@ -1166,7 +1168,7 @@ def detect_horizon(
     starts = [(c, t) for c, t, _ in raw[: 2 * n_candidates]] + priors
 
     # 3. refinement, 4. region statistics
-    cum = _strip_features(colour, gx, gy, n_strips)
+    cum = _strip_features(colour, gx, gy, P)
     band = max(3, round(0.04 * h))
     search = max(3.0, 0.03 * h)
     cands: list[_Candidate] = []
@@ -1268,18 +1270,27 @@ def _nominal(camera: PinholeCamera | None, W: int, H: int) -> HorizonEstimate | 
 
 
 def _strip_features(
-    colour: np.ndarray, gx: np.ndarray, gy: np.ndarray, n_strips: int
+    colour: np.ndarray, gx: np.ndarray, gy: np.ndarray, P: np.ndarray
 ) -> np.ndarray:
     """Cumulative row sums (h + 1, S, C + 1) of strip-mean features: the colour channels
-    and the texture ``|∇g|`` (Gaussian σ = 1 px), each divided by its robust spread (10th
-    to 90th percentile over the strip means), so that distances are in spread units.
+    and the texture ``|g_x| + |g_y − P|`` (``P`` the strip-row means of ``g_y``, (h, S);
+    Gaussian σ = 1 px), each divided by its robust spread (10th to 90th percentile over
+    the strip means), so that distances are in spread units.
+
+    The texture leaves out the strip's mean vertical gradient: a straight edge across
+    the strip — the horizon itself — is no texture, while waves and clouds are. With
+    ``|∇g|`` the horizon's own edge, blurred over the rows next to it, made the band
+    just below it look like another region (rendered night clip, seed 0: the region
+    test failed a line with 99 % support, and the horizon was lost in 26 of 200 frames).
 
     A grey frame's one channel is weighted √3: distances are then those of the same
     frame stored as BGR (three equal channels), so a thermal camera's 1-channel frames
     and their 3-channel copies give one line (before, the 1-channel MarDCT frames lost
     the horizon in 19 of their first 20 frames that their RGBA copies keep)."""
-    h = colour.shape[0]
-    tex = cv2.GaussianBlur(np.abs(gx) + np.abs(gy), (0, 0), 1.0)
+    h, w = colour.shape[:2]
+    n_strips = P.shape[1]
+    row_mean = cv2.resize(P, (w, h), interpolation=cv2.INTER_NEAREST)
+    tex = cv2.GaussianBlur(np.abs(gx) + np.abs(gy - row_mean), (0, 0), 1.0)
     col = cv2.resize(colour, (n_strips, h), interpolation=cv2.INTER_AREA).reshape(h, n_strips, -1)
     tx = cv2.resize(tex, (n_strips, h), interpolation=cv2.INTER_AREA).reshape(h, n_strips, 1)
     F = np.concatenate([col, tx], axis=2)
