@@ -376,6 +376,33 @@ def test_rendered_coast_on_part_of_the_horizon_does_not_tilt_the_line(coast_erro
         assert e0 < 0.5 and e1 < 0.5, (k, e0, e1)
 
 
+def test_rendered_coast_over_most_of_the_horizon_is_tracked_for_eight_seconds(tmp_path: Path):
+    """The whole rendered crossing clip, seed 0 (8 s, 200 frames): frame by frame, step
+    6b's two lines — the coast's top and the straight sea horizon below it — score
+    within a few hundredths by the region test, and alone each frame takes one or the
+    other (the left end 7.2 px off on average). Through :class:`HorizonTracker` the
+    previous line weighs the close call, so the tracked line stays on the horizon:
+    both ends within 0.5 px in every frame it is found (measured 0.36 px at most;
+    before, 28.9). The straight line's confidence is 0.29–0.45 (the found threshold is
+    0.3): after five detections under it in a row the tracker reports one frame lost."""
+    import csv
+
+    from seawatch.io.video import VideoReader
+    from seawatch.synth import render_case
+
+    render_case("crossing", tmp_path, duration=8.0, width=960, height=540, seed=0)
+    with (tmp_path / "horizon.csv").open() as fh:
+        truth = [(float(r["y0"]), float(r["y1"])) for r in csv.DictReader(fh)]
+    tracker = HorizonTracker()
+    found = 0
+    for frame, (t0, t1) in zip(VideoReader(tmp_path / "video.mp4"), truth, strict=True):
+        est = tracker.update(frame.image, time=frame.time)
+        if est.found:
+            found += 1
+            assert abs(est.y0 - t0) < 0.5 and abs(est.y1 - t1) < 0.5, (frame.index, est.y0, t0)
+    assert found >= 198, found
+
+
 def test_rendered_coast_from_the_left_border_keeps_the_open_sea_end(coast_errors):
     """Rendered crossing, seed 0 (the coast from the left border over two-thirds of the
     width): the line's right end, on the open sky/sea edge, stays within 2.5 px of the
@@ -386,18 +413,16 @@ def test_rendered_coast_from_the_left_border_keeps_the_open_sea_end(coast_errors
         assert e1 < 2.5, (k, e1)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="known failure (issue 6): rendered crossing, seed 0: the coarse line follows "
-    "the top of a coast over the left two-thirds and meets the sky/sea edge only at the "
-    "right end, so the sea horizon on the left lies outside the refinement's search "
-    "window (left end 28-29 px high in 192 of 200 frames)",
-)
 def test_rendered_coast_over_most_of_the_horizon_does_not_tilt_the_line(coast_errors):
-    """Rendered crossing, seed 0: the same within 2 px where the coast covers the horizon
-    from the left border over two-thirds of the width."""
+    """Rendered crossing, seed 0: a coast covers the horizon from the left border over
+    two-thirds of the width. The coarse line follows the coast's top and meets the
+    sky/sea edge only at the right end, so the sea horizon on the left lies beyond the
+    refinement's bins; step 6b then looks for the straightest edge down to 8 % of the
+    height below the line (the sky/sea edge on both sides of the coast): both ends
+    within 0.5 px in every frame (measured 0.05 and 0.38 px at most; before, the left
+    end was 28–29 px high in 23 of these 25 frames)."""
     for k, e0, e1 in coast_errors(0):
-        assert e0 < 2.0 and e1 < 2.0, (k, e0, e1)
+        assert e0 < 0.5 and e1 < 0.5, (k, e0, e1)
 
 
 # ----------------------------------------------------------------------------- no horizon

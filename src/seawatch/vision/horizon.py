@@ -78,18 +78,22 @@ the colour channels on the same scale. Then:
    half the bins (not one straight edge: e.g. a line through a hull on one side and
    the horizon on the other), a candidate with a better ``q · prior`` that crosses it
    inside the image and does hold half the bins replaces it.
-6b. **The straightest edge.** A refined line that holds under 60 % of the bins may join
+6b. **The straightest edge.** A refined line that holds under 80 % of the bins may join
    two edges: the sky/sea edge on the open side and the top of a coast that sits on the
    horizon on the other (the coast's own water line, the sea's true edge there, is a
    weak edge of the other polarity and seldom a candidate). The line through the most
    bin edge points within 0.5 px (every pair a quarter of the width apart tried, then a
    least-squares fit to its points; at least a quarter of the points, spanning a quarter
-   of the width) replaces it when it moves an end down by more than 2 px and neither up
-   by more (a coast on the horizon lies above the sea's edge, never below it), keeps the
-   tilt limits, and has the higher region score (step 4): the straight sky/sea part,
-   extended across the coast. Where the coarse line meets the sky/sea edge only near one
-   border, the horizon beyond lies outside the refinement's search window and is not
-   recovered.
+   of the width) replaces it when it moves an end by more than 2 px and neither up by
+   more than 1 % of the height (a coast on the horizon lies above the sea's edge, never
+   below it; the refined line's far end, extrapolated, may lie a little low), keeps the
+   tilt limits, and has the higher region score (step 4), each score weighed by the
+   line's prior (a tracked horizon decides a close call for the line it continues):
+   the straight sky/sea part, extended across the coast. Where the coarse line meets
+   the sky/sea edge only near one border, the horizon beyond lies outside the bins'
+   search window: if the bins give no such line, each bin's strongest edge of the
+   refined line's polarity from 2 px above it to 8 % of the height below it is taken
+   instead, and the straightest line through those is tried the same way.
 
 The thresholds were chosen on synthetic scenes and checked on six real images, a
 real thermal clip and rendered footage (see the tests); the confidence is a score,
@@ -526,11 +530,13 @@ _FINE_SCALE = (1.0, 2.0)  # [full px] bounds of the Tukey cut-off of the final l
 _FINE_MIN_SUPPORT = 0.3  # least fraction of the bins on the fine line for it to be used
 _FINE_GOOD = 0.5  # a fine line with less support makes crossing candidates compete
 _SAME_LINE = 2.0  # [working px] candidates closer than this (mean |Δy|) are one line
-_STRAIGHT_BELOW = 0.6  # step 6b runs where the refined line holds fewer of the bins
+_STRAIGHT_BELOW = 0.8  # step 6b runs where the refined line holds fewer of the bins
 _STRAIGHT_TOL = 0.5  # [full px] an edge point within this of a line is on it (step 6b)
 _STRAIGHT_MIN = 0.25  # least fraction of the edge points on the straightest line
 _STRAIGHT_SPAN = 0.25  # least fraction of the width its points (and a hypothesis) span
 _STRAIGHT_MOVE = 2.0  # [full px] it replaces the refined line only if an end moves more
+_STRAIGHT_ABOVE = 0.01  # [image heights] nor if an end rises more (a coast's top)
+_STRAIGHT_DEPTH = 0.08  # [image heights] how far below the line step 6b looks after that
 _LUMA_BGR = np.array([0.114, 0.587, 0.299])  # ITU-R BT.601 weights (OpenCV's BGR2GRAY)
 _LUMA_GREY = np.array([1.0])
 _BGR2GREY = cv2.COLOR_BGR2GRAY
@@ -900,6 +906,7 @@ class _Fine:
     support: float
     x: np.ndarray
     y: np.ndarray
+    polarity: float  # the bins' majority polarity (+1: brighter below)
 
 
 def _straightest(x: np.ndarray, y: np.ndarray, width: int) -> tuple[float, float] | None:
@@ -977,7 +984,44 @@ def _fine_line(
     )
     if not (math.isfinite(n0) and support >= _FINE_MIN_SUPPORT):
         return None
-    return _Fine(float(n0), float(n1), float(support), ex, ey)
+    polarity = 1.0 if float(np.sum(pol)) > 0.0 else -1.0
+    return _Fine(float(n0), float(n1), float(support), ex, ey, polarity)
+
+
+def _edges_below(
+    arr: np.ndarray, y0: float, y1: float, depth: float, polarity: float, sy: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Step 6b's wider search: per column bin, the strongest edge of ``polarity`` (+1:
+    brighter below) from 2 px above the line (y0, y1) [full px] to ``depth`` [px] below
+    it, with step 6's sub-pixel row and signal-to-noise test; the edge points (column,
+    row) [px]. The sea horizon under a coast lies at or below a line along the coast's
+    top, as far below as the coast is high."""
+    H, W = arr.shape[:2]
+    t = (y1 - y0) / (W - 1)
+    S = math.ceil(0.5 * depth) + 2  # search half-range about the band's middle [px]
+    g_max = max(3, math.ceil(sy))
+    R = S + 2 * g_max + 1
+    nb = min(_FINE_BINS, max(8, W // 2))
+    bin_w = -(-W // nb)
+    nb = -(-W // bin_w)
+    yc = y0 + 0.5 * depth
+    top = max(0, math.floor(min(yc, yc + t * (W - 1)) + 0.5) - R)
+    bottom = min(H, math.floor(max(yc, yc + t * (W - 1)) + 0.5) + R + 1)
+    band = arr[top:bottom] if arr.ndim == 2 else cv2.cvtColor(arr[top:bottom], _BGR2GREY)
+    img = band.astype(np.float32).reshape(-1, W, 1)
+    prof, rbar, xbar, cnt = _fine_profiles(img, _LUMA_GREY, yc - top, t, R, bin_w, nb)
+    pol = np.full(nb, polarity)
+    peak, width = _fine_peaks(prof, pol, R, S)
+    found = (peak >= 0) & (cnt > 0)
+    if found.sum() < 4:
+        return np.empty(0), np.empty(0)
+    g = min(max(math.ceil(2.5 * float(np.median(width[found])) + 0.5), 2), g_max)
+    e, step, noise = _fine_edges(prof, np.where(found, peak, -1), pol, g, max(3, g))
+    ok = np.isfinite(e)
+    if ok.sum() < 4:
+        return np.empty(0), np.empty(0)
+    good = ok & (np.abs(step) >= _FINE_SNR * np.maximum(noise, float(np.median(noise[ok]))))
+    return xbar[good], rbar[good] + top - R + e[good]
 
 
 def _local_maxima(E: np.ndarray, count: int, rad_t: int, rad_c: int) -> list[tuple[int, int]]:
@@ -1167,6 +1211,14 @@ def detect_horizon(
     raw.sort(key=lambda r: -r[2])
     starts = [(c, t) for c, t, _ in raw[: 2 * n_candidates]] + priors
 
+    def prior_of(c: float, t: float) -> float:
+        """The priors' weight of the working line (c, t): 1 on each, 0.5 far away."""
+        prior = 1.0
+        for pc, pt in priors:
+            d = abs(c - pc) + 0.25 * w * abs(t - pt)  # mean |Δy| over the width
+            prior *= 0.5 + 0.5 * math.exp(-0.5 * (d / (_PRIOR_SIGMA * h)) ** 2)
+        return prior
+
     # 3. refinement, 4. region statistics
     cum = _strip_features(colour, gx, gy, P)
     band = max(3, round(0.04 * h))
@@ -1179,11 +1231,7 @@ def detect_horizon(
         if not ok or not (lo_t * 1.05 - 1e-9 <= t <= hi_t * 1.05 + 1e-9) or not 0 <= c < h:
             continue
         region = float(_region(cum, c, t, xs, xc, band, 2))
-        prior = 1.0
-        for pc, pt in priors:
-            d = abs(c - pc) + 0.25 * w * abs(t - pt)  # mean |Δy| over the width
-            prior *= 0.5 + 0.5 * math.exp(-0.5 * (d / (_PRIOR_SIGMA * h)) ** 2)
-        cands.append(_Candidate(c, t, q, support, contrast, region, prior))
+        cands.append(_Candidate(c, t, q, support, contrast, region, prior_of(c, t)))
     if not cands:
         return result((h - 1) / 2.0, 0.0, 0.0)
 
@@ -1230,24 +1278,40 @@ def detect_horizon(
                 chosen, fine = cd, alt
                 break
     y0, y1 = to_full(chosen.c, chosen.t) if fine is None else (fine.y0, fine.y1)
-    region_score = chosen.region
+    region_score, prior = chosen.region, chosen.prior
     # 6b. a line that holds few of the bins may join two edges (the sky/sea edge on the
     # open side and the top of a coast on the other): the straightest edge among the
-    # bins replaces it where it lies nowhere above it (the sea's edge is the lowest) and
-    # is the better sea horizon by the region test
+    # bins, or else among the edges below it, replaces it where it lies nowhere above it
+    # (the sea's edge is the lowest) and is the better sea horizon by the region test
     if fine is not None and fine.support < _STRAIGHT_BELOW:
-        alt_ends = _straightest(fine.x, fine.y, W)
-        if (
-            alt_ends is not None
-            and max(abs(alt_ends[0] - y0), abs(alt_ends[1] - y1)) > _STRAIGHT_MOVE
-            and min(alt_ends[0] - y0, alt_ends[1] - y1) >= -_STRAIGHT_MOVE
-        ):
+
+        def straighter(alt_ends: tuple[float, float] | None) -> float | None:
+            """The region score of ``alt_ends`` where it may replace (y0, y1), else None."""
+            if (
+                alt_ends is None
+                or max(abs(alt_ends[0] - y0), abs(alt_ends[1] - y1)) <= _STRAIGHT_MOVE
+                or min(alt_ends[0] - y0, alt_ends[1] - y1) < -_STRAIGHT_ABOVE * H
+            ):
+                return None
             c_a, t_a = to_work(*alt_ends)
             r_a = float(_region(cum, c_a, t_a, xs, xc, band, 2))
-            if lo_t <= t_a <= hi_t and 0.0 <= c_a < h and r_a > region_score:
-                (y0, y1), region_score = alt_ends, r_a
+            # with a previous line, each weighed by its prior: the one it continues wins
+            # a close call (two edges of about one score would otherwise alternate)
+            ahead = r_a * prior_of(c_a, t_a) > region_score * prior_of(*to_work(y0, y1))
+            ok = lo_t <= t_a <= hi_t and 0.0 <= c_a < h and ahead
+            return r_a if ok else None
+
+        alt_ends = _straightest(fine.x, fine.y, W)
+        r_a = straighter(alt_ends)
+        if r_a is None:  # the sea's edge may lie beyond the bins' reach: look lower
+            below = _edges_below(arr, y0, y1, _STRAIGHT_DEPTH * H, fine.polarity, sy)
+            alt_ends = _straightest(*below, W)
+            r_a = straighter(alt_ends)
+        if r_a is not None and alt_ends is not None:
+            (y0, y1), region_score = alt_ends, r_a
+            prior = prior_of(*to_work(y0, y1))  # the line's own, not the coarse one's
     region = 1.0 - math.exp(-region_score / _REGION_SCALE)
-    conf = float(np.clip(math.sqrt(chosen.quality * chosen.prior * region), 0.0, 1.0))
+    conf = float(np.clip(math.sqrt(chosen.quality * prior * region), 0.0, 1.0))
     found = conf >= min_confidence and conf > 0.0
     return HorizonEstimate.from_endpoints(y0, y1, W, H, found=found, confidence=conf)
 
