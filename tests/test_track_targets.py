@@ -41,10 +41,15 @@ SMALL = {"width": 960, "height_px": 540, "fps": 5.0}
 
 # measured at 960×540, 5 frames/s (seed 0) — the reasons of the strict xfails below
 XFAIL: dict[tuple[str, str], str] = {
-    ("range-1km", "range1km"): (
-        "issue 7 '5 % at 1 km' not met at 960x540: EKF range error 5.39 % RMS (bias "
-        "-3.73 %) in the 750-1250 m bin (met at 1080p/10 fps, docs/results/track/); at "
-        "half the resolution one water-line pixel is twice the angle"
+    ("uav-sea", "rmse30"): (
+        "issue 7 'EKF 30 % below point-wise geometry' not met since the horizon refines "
+        "the attitude in every frame it is found (session 17): EKF 51.7 m vs geometry "
+        "58.0 m (ratio 0.89; 1080p: 16.6 vs 19.5 m, 0.85); both were worse before, when "
+        "frames under confidence 0.5 took the attitude without the sway: EKF 74.6 m, "
+        "geometry 166.0 m (ratio 0.45). What is left is a bias, which no filtering "
+        "removes: at 1080p the EKF's range error is 2.77 % RMS with a mean of -2.72 % "
+        "at 250-500 m and 4.19 % with -4.10 % at 500-750 m (about 0.27 px on the "
+        "water line)"
     ),
 }
 
