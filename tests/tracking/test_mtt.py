@@ -9,6 +9,7 @@ hand-derived confirmation/deletion timings.
 from __future__ import annotations
 
 import itertools
+import math
 
 import numpy as np
 import pytest
@@ -731,3 +732,34 @@ def test_occlusion_a_ship_emerging_from_behind_grows_to_its_box(in_front):
         if k >= 42:  # clear of B since frame 34
             assert abs(err) < 0.3, (k, err)
             assert st.boxes[a, 2][0] > 53.0
+
+
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(
+    width=st.floats(24.0, 80.0),
+    seen=st.floats(0.2, 0.6),
+    speed=st.floats(0.5, 2.0),
+    gap=st.floats(3.0, 10.0),
+)
+def test_occlusion_an_emerging_ship_is_never_further_off_than_its_hidden_half(
+    width, seen, speed, gap
+):
+    """Property of the rule above over ship widths, the part seen at birth, speeds and
+    the in-front ship's water-line lead (more than the 2-px tolerance): while the ship
+    comes out from behind, its track's centre is off by at most half the part still
+    hidden (plus the filter's lag, 0.5 px) — never by half of all it has not yet seen
+    at birth — and once clear it is on the truth within 0.5 px."""
+    trk = _tracker(confirm_m=1, confirm_n=1, occlusion=True, overlap_gate=0.5)
+    front = [300.0, 200.0 + gap - 20.0, 1.5 * width, 20.0]  # water line `gap` px lower
+    left0 = 300.0 - seen * width
+    frames = math.ceil((1.0 - seen) * width / speed) + 30
+    for k in range(frames):
+        left = left0 - speed * k
+        visible = min(width, 300.0 - left)
+        st_ = trk.step(np.array([[left, 186.0, visible, 14.0], front]))
+        err = abs(left + 0.5 * width - st_.states[st_.ids == 1, 0][0])
+        hidden = width - visible
+        if k >= 8 and hidden > 0.0:
+            assert err <= 0.5 * hidden + 0.5, (k, err, hidden)
+        if k == frames - 1:
+            assert err < 0.5, err
