@@ -1345,7 +1345,7 @@ def _strip_features(
     the strip — the horizon itself — is no texture, while waves and clouds are. With
     ``|∇g|`` the horizon's own edge, blurred over the rows next to it, made the band
     just below it look like another region (rendered night clip, seed 0: the region
-    test failed a line with 99 % support, and the horizon was lost in 26 of 200 frames).
+    test failed a line with 99 % support, and the tracked horizon was lost in 16 of 200 frames).
 
     A grey frame's one channel is weighted √3: distances are then those of the same
     frame stored as BGR (three equal channels), so a thermal camera's 1-channel frames
