@@ -819,6 +819,57 @@ def _strip_polarity(
 
 
 @njit(cache=True, nogil=True)
+def _fine_points(
+    prof: np.ndarray,
+    rbar: np.ndarray,
+    xbar: np.ndarray,
+    pol: np.ndarray,
+    R: int,
+    S: int,
+    g_max: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Step 6's edge points of the bin profiles: each bin's edge row (:func:`_fine_peaks`,
+    :func:`_fine_edges`; ``rbar`` the bins' mean rows [px] at the profile centre) where
+    its step ``|D|`` is at least ``_FINE_SNR`` times its profile noise (or the median
+    noise, if larger). Returns the points' columns and rows [px] and ``|D|``, in bin
+    order; none when under 4 bins have an edge."""
+    nb = prof.shape[0]
+    none = np.empty(0)
+    peak, width = _fine_peaks(prof, pol, R, S)
+    wid = np.empty(nb)
+    k = 0
+    for b in range(nb):
+        if peak[b] >= 0:
+            wid[k] = width[b]
+            k += 1
+    if k < 4:
+        return none, none, none
+    # transition half-window: 2.5 RMS widths of the edge, at least 2 px; levels over
+    # max(3, g) rows beyond it
+    g = min(max(math.ceil(2.5 * np.median(wid[:k]) + 0.5), 2), g_max)
+    e, D, noise = _fine_edges(prof, peak, pol, g, max(3, g))
+    k = 0
+    for b in range(nb):
+        if np.isfinite(e[b]):
+            wid[k] = noise[b]
+            k += 1
+    if k < 4:
+        return none, none, none
+    noise_ref = np.median(wid[:k])
+    xb = np.empty(nb)
+    yb = np.empty(nb)
+    wb = np.empty(nb)
+    n = 0
+    for b in range(nb):
+        if np.isfinite(e[b]) and abs(D[b]) >= _FINE_SNR * max(noise[b], noise_ref):
+            xb[n] = xbar[b]
+            yb[n] = rbar[b] - R + e[b]
+            wb[n] = abs(D[b])
+            n += 1
+    return xb[:n], yb[:n], wb[:n]
+
+
+@njit(cache=True, nogil=True)
 def _fine_fit(
     prof: np.ndarray,
     rbar: np.ndarray,
@@ -834,9 +885,8 @@ def _fine_fit(
     s_max: float,
     dev: float,
 ) -> tuple[float, float, float]:
-    """Step 6 on the bin profiles: edge rows per bin (:func:`_fine_peaks`,
-    :func:`_fine_edges`), the bins whose step exceeds ``_FINE_SNR`` times their profile
-    noise (or the median noise, if larger), and the robust line through them
+    """Step 6 on the bin profiles: the bins' edge points (:func:`_fine_points`) and the
+    robust line through them
     (:func:`_robust_line`, weights ``min(|D|, median |D|)``: a dark hull is no better
     evidence than the horizon), which may move the ends of the coarse line ``y0 + t x``
     by at most ``dev`` [px]. Returns ``(n0, n1, support, x, y)``: the refined rows at the
@@ -848,52 +898,30 @@ def _fine_fit(
     for b in range(nb):
         if cnt[b] > 0:
             n_used += 1
-    peak, width = _fine_peaks(prof, pol, R, S)
-    wid = np.empty(nb)
-    k = 0
-    for b in range(nb):
-        if peak[b] >= 0:
-            wid[k] = width[b]
-            k += 1
-    if k < 4:
-        return np.nan, np.nan, 0.0, np.empty(0), np.empty(0)
-    # transition half-window: 2.5 RMS widths of the edge, at least 2 px; levels over
-    # max(3, g) rows beyond it
-    g = min(max(math.ceil(2.5 * np.median(wid[:k]) + 0.5), 2), g_max)
-    e, D, noise = _fine_edges(prof, peak, pol, g, max(3, g))
-    k = 0
-    for b in range(nb):
-        if np.isfinite(e[b]):
-            wid[k] = noise[b]
-            k += 1
-    if k < 4:
-        return np.nan, np.nan, 0.0, np.empty(0), np.empty(0)
-    noise_ref = np.median(wid[:k])
-    xb = np.empty(nb)
-    yb = np.empty(nb)
-    wb = np.empty(nb)
-    n = 0
-    for b in range(nb):
-        if np.isfinite(e[b]) and abs(D[b]) >= _FINE_SNR * max(noise[b], noise_ref):
-            xb[n] = xbar[b] - xm
-            yb[n] = rbar[b] - R + e[b]
-            wb[n] = abs(D[b])
-            n += 1
+    x, y, wb = _fine_points(prof, rbar, xbar, pol, R, S, g_max)
+    n = x.shape[0]
     if n < 4:
         return np.nan, np.nan, 0.0, np.empty(0), np.empty(0)
-    cap = np.median(wb[:n])
+    xb = x - xm
+    cap = np.median(wb)
     for i in range(n):
         wb[i] = min(wb[i], cap)
-    c, tt, inliers = _robust_line(
-        xb[:n], yb[:n], wb[:n], y0 + t * xm, t, _FINE_SCALE[0], s_max, xm, dev
-    )
+    c, tt, inliers = _robust_line(xb, y, wb, y0 + t * xm, t, _FINE_SCALE[0], s_max, xm, dev)
     support = inliers / max(n_used, 1)
     n0 = c - tt * xm
     n1 = c + tt * xm
-    xs, ys = xb[:n] + xm, yb[:n].copy()
+    xs, ys = xb + xm, y
     if max(abs(n0 - y0), abs(n1 - (y0 + 2.0 * t * xm))) > dev:
         return np.nan, np.nan, support, xs, ys
     return n0, n1, support, xs, ys
+
+
+def _fine_bins(width: int) -> tuple[int, int]:
+    """Step 6's column bins of an image ``width`` [px] wide: (bin width, bin count), at
+    most :data:`_FINE_BINS` bins of equal width (the last one shorter)."""
+    nb = min(_FINE_BINS, max(8, width // 2))
+    bin_w = -(-width // nb)
+    return bin_w, -(-width // bin_w)
 
 
 @dataclass(frozen=True)
@@ -962,9 +990,7 @@ def _fine_line(
     S = math.ceil(1.25 * sy) + 1  # search half-range of the edge [px]
     g_max = max(3, math.ceil(sy))  # largest transition half-window [px]
     R = S + 2 * g_max + 1
-    nb = min(_FINE_BINS, max(8, W // 2))
-    bin_w = -(-W // nb)
-    nb = -(-W // bin_w)
+    bin_w, nb = _fine_bins(W)
     top = max(0, math.floor(min(y0, y1) + 0.5) - R)
     bottom = min(H, math.floor(max(y0, y1) + 0.5) + R + 1)
     if arr.ndim == 2 or 0 < bottom - top <= 3 * (2 * R + 1):
@@ -1001,27 +1027,15 @@ def _edges_below(
     S = math.ceil(0.5 * depth) + 2  # search half-range about the band's middle [px]
     g_max = max(3, math.ceil(sy))
     R = S + 2 * g_max + 1
-    nb = min(_FINE_BINS, max(8, W // 2))
-    bin_w = -(-W // nb)
-    nb = -(-W // bin_w)
+    bin_w, nb = _fine_bins(W)
     yc = y0 + 0.5 * depth
     top = max(0, math.floor(min(yc, yc + t * (W - 1)) + 0.5) - R)
     bottom = min(H, math.floor(max(yc, yc + t * (W - 1)) + 0.5) + R + 1)
     band = arr[top:bottom] if arr.ndim == 2 else cv2.cvtColor(arr[top:bottom], _BGR2GREY)
     img = band.astype(np.float32).reshape(-1, W, 1)
-    prof, rbar, xbar, cnt = _fine_profiles(img, _LUMA_GREY, yc - top, t, R, bin_w, nb)
-    pol = np.full(nb, polarity)
-    peak, width = _fine_peaks(prof, pol, R, S)
-    found = (peak >= 0) & (cnt > 0)
-    if found.sum() < 4:
-        return np.empty(0), np.empty(0)
-    g = min(max(math.ceil(2.5 * float(np.median(width[found])) + 0.5), 2), g_max)
-    e, step, noise = _fine_edges(prof, np.where(found, peak, -1), pol, g, max(3, g))
-    ok = np.isfinite(e)
-    if ok.sum() < 4:
-        return np.empty(0), np.empty(0)
-    good = ok & (np.abs(step) >= _FINE_SNR * np.maximum(noise, float(np.median(noise[ok]))))
-    return xbar[good], rbar[good] + top - R + e[good]
+    prof, rbar, xbar, _ = _fine_profiles(img, _LUMA_GREY, yc - top, t, R, bin_w, nb)
+    x, y, _ = _fine_points(prof, rbar + top, xbar, np.full(nb, polarity), R, S, g_max)
+    return x, y
 
 
 def _local_maxima(E: np.ndarray, count: int, rad_t: int, rad_c: int) -> list[tuple[int, int]]:
