@@ -14,7 +14,9 @@ IMU-derived horizon masks (WaSR repository, ``examples/``, Apache-2.0;
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -282,6 +284,29 @@ def test_a_large_hull_below_the_horizon_on_one_side_does_not_tilt_the_line():
 
 
 # ----------------------------------------------------------------------------- rendered footage
+def _clip_frames(folder: Path) -> Iterator[tuple[Any, tuple[float, float]]]:
+    """The frames of a rendered clip's ``video.mp4`` in ``folder``, decoded one by one,
+    each with its true horizon (y0, y1) [px] from the renderer's ``horizon.csv`` (as
+    many rows as frames, else ValueError)."""
+    import csv
+
+    from seawatch.io.video import VideoReader
+
+    with (folder / "horizon.csv").open() as fh:
+        truth = [(float(r["y0"]), float(r["y1"])) for r in csv.DictReader(fh)]
+    yield from zip(VideoReader(folder / "video.mp4"), truth, strict=True)
+
+
+def _rendered(
+    folder: Path, case: str, duration: float, seed: int
+) -> Iterator[tuple[Any, tuple[float, float]]]:
+    """:func:`_clip_frames` of ``case`` rendered at 960 × 540 for ``duration`` [s]."""
+    from seawatch.synth import render_case
+
+    render_case(case, folder, duration=duration, width=960, height=540, seed=seed)
+    return _clip_frames(folder)
+
+
 def test_rendered_footage_horizon_matches_the_renderer_truth(tmp_path: Path):
     """One second of the range-1km clip (1080p, camera on a swaying boat, a ferry in
     view, H.264) against the renderer's horizon.csv (exact geometry of §4.2).
@@ -290,21 +315,17 @@ def test_rendered_footage_horizon_matches_the_renderer_truth(tmp_path: Path):
     edge is the geometric horizon: the centre row and the tilt (the difference of the
     two ends) are checked to 0.1 px (measured: 0.01–0.03 px at 1080p and 720p).
     """
-    import csv
-
-    from seawatch.io.video import VideoReader
     from seawatch.synth.platform_clip import platform_clip_preset, render_platform_clip
 
     render_platform_clip(tmp_path, **platform_clip_preset("range-1km", duration=1.0))
-    with (tmp_path / "horizon.csv").open() as fh:
-        truth = [(float(r["y0"]), float(r["y1"])) for r in csv.DictReader(fh)]
-    frames = list(VideoReader(tmp_path / "video.mp4"))
-    assert len(frames) == len(truth) >= 10
-    for frame, (t0, t1) in zip(frames, truth, strict=True):
+    n = 0
+    for frame, (t0, t1) in _clip_frames(tmp_path):
+        n += 1
         est = detect_horizon(frame.image)
         assert est.found
         assert abs(est.offset - 0.5 * (t0 + t1)) < 0.1, (frame.index, est.y0, est.y1, t0, t1)
         assert abs((est.y1 - est.y0) - (t1 - t0)) < 0.1, (frame.index, est.y0, est.y1, t0, t1)
+    assert n >= 10
 
 
 def test_rendered_night_horizon_is_found_in_every_frame(tmp_path: Path):
@@ -313,41 +334,25 @@ def test_rendered_night_horizon_is_found_in_every_frame(tmp_path: Path):
     within 0.5 px of the renderer's line at both ends. The region test's texture once
     counted the horizon's own edge, blurred into the band just below it, as the sea's:
     the line failed the test and was lost in 16 of the 75 frames (52–71)."""
-    import csv
-
-    from seawatch.io.video import VideoReader
-    from seawatch.synth import render_case
-
-    render_case("night", tmp_path, duration=3.0, width=960, height=540, seed=0)
-    with (tmp_path / "horizon.csv").open() as fh:
-        truth = [(float(r["y0"]), float(r["y1"])) for r in csv.DictReader(fh)]
-    frames = list(VideoReader(tmp_path / "video.mp4"))
-    assert len(frames) == len(truth) == 75
-    for frame, (t0, t1) in zip(frames, truth, strict=True):
+    n = 0
+    for frame, (t0, t1) in _rendered(tmp_path, "night", 3.0, seed=0):
+        n += 1
         est = detect_horizon(frame.image)
         assert est.found, (frame.index, est.confidence)
         assert abs(est.y0 - t0) < 0.5 and abs(est.y1 - t1) < 0.5, (frame.index, est.y0, est.y1)
+    assert n == 75
 
 
 def _coast_clip_errors(tmp_path: Path, seed: int) -> list[tuple[int, float, float]]:
     """One second of the rendered crossing case (960 × 540) with rendering ``seed``:
     (frame, |Δy| at the left end, at the right end) [px] of detect_horizon's line against
     the renderer's horizon.csv."""
-    import csv
-
-    from seawatch.io.video import VideoReader
-    from seawatch.synth import render_case
-
-    render_case("crossing", tmp_path, duration=1.0, width=960, height=540, seed=seed)
-    with (tmp_path / "horizon.csv").open() as fh:
-        truth = [(float(r["y0"]), float(r["y1"])) for r in csv.DictReader(fh)]
-    frames = list(VideoReader(tmp_path / "video.mp4"))
-    assert len(frames) == len(truth) == 25
     out = []
-    for frame, (t0, t1) in zip(frames, truth, strict=True):
+    for frame, (t0, t1) in _rendered(tmp_path, "crossing", 1.0, seed=seed):
         est = detect_horizon(frame.image)
         assert est.found
         out.append((frame.index, abs(est.y0 - t0), abs(est.y1 - t1)))
+    assert len(out) == 25
     return out
 
 
@@ -385,22 +390,15 @@ def test_rendered_coast_over_most_of_the_horizon_is_tracked_for_eight_seconds(tm
     both ends within 0.5 px in every frame it is found (measured 0.36 px at most;
     before, 28.9). The straight line's confidence is 0.29–0.45 (the found threshold is
     0.3): after five detections under it in a row the tracker reports one frame lost."""
-    import csv
-
-    from seawatch.io.video import VideoReader
-    from seawatch.synth import render_case
-
-    render_case("crossing", tmp_path, duration=8.0, width=960, height=540, seed=0)
-    with (tmp_path / "horizon.csv").open() as fh:
-        truth = [(float(r["y0"]), float(r["y1"])) for r in csv.DictReader(fh)]
     tracker = HorizonTracker()
-    found = 0
-    for frame, (t0, t1) in zip(VideoReader(tmp_path / "video.mp4"), truth, strict=True):
+    found = n = 0
+    for frame, (t0, t1) in _rendered(tmp_path, "crossing", 8.0, seed=0):
+        n += 1
         est = tracker.update(frame.image, time=frame.time)
         if est.found:
             found += 1
             assert abs(est.y0 - t0) < 0.5 and abs(est.y1 - t1) < 0.5, (frame.index, est.y0, t0)
-    assert found >= 198, found
+    assert n == 200 and found >= 198, (n, found)
 
 
 def test_rendered_coast_from_the_left_border_keeps_the_open_sea_end(coast_errors):
