@@ -963,8 +963,8 @@ class ClassicalShipDetector:
         # the sea by more than its height is a cloud or a coast feature
         cands = [c for c in cands if self._near_sea(c, fr, mask, ends, tol, 1.0)]
         out, polarity = [], []
+        refine = self._refine if self.refine == "flank" else self._refine_mask
         for c in cands:
-            refine = self._refine if self.refine == "flank" else self._refine_mask
             objects = refine(c, levels[c.level], fr)
             if objects and self.refine == "mask" and c.polarity == 1:
                 # a bright candidate must also stand out against a background of its own
