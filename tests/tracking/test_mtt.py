@@ -763,3 +763,37 @@ def test_occlusion_an_emerging_ship_is_never_further_off_than_its_hidden_half(
             assert err <= 0.5 * hidden + 0.5, (k, err, hidden)
         if k == frames - 1:
             assert err < 0.5, err
+
+
+@pytest.mark.parametrize("behind", [False, True])
+def test_occlusion_a_box_around_a_ship_with_its_own_box_is_the_track_s(behind):
+    """Two ships start bow to bow: A (58 × 14 px, water line at row 214) and B in front
+    of it (28 × 12 px, water line 215, 0.2 px/frame faster). For three frames the
+    detector boxes B and the 30 px of A beside it, then B and the whole of A, whose box
+    spans B's. A track born on A's 30 px kept that width, measured by A's free right
+    end, as long as its box's left end was on B's span: 14 px off (overtaking case,
+    seeds 1 and 2: 40 frames). B having a box of its own, A's box is no merge of the
+    two: A is measured by its box, its id kept, and within 0.3 px of A's centre ten
+    frames on. Where B is behind A (water line above A's) the box's left end may be
+    B's, and A keeps its remembered width. The tracker's settings are VisualTracker's
+    defaults."""
+    trk = _tracker(
+        confirm_m=3,
+        confirm_n=5,
+        occlusion=True,
+        overlap_gate=0.5,
+        sigma_a=0.5,
+        sigma_z=2.0,
+        sigma_z_rel=0.03,
+    )
+    b_top = 197.0 if behind else 203.0
+    for k in range(25):
+        a_left, b_left = 100.0 + 0.5 * k, 100.0 + 0.7 * k
+        a = [a_left + 28.0, 200.0, 30.0, 14.0] if k < 3 else [a_left, 200.0, 58.0, 14.0]
+        st = trk.step(np.array([a, [b_left, b_top, 28.0, 12.0]]))
+        assert st.ids.tolist() == [1, 2]
+        err = a_left + 29.0 - st.states[0, 0]
+        if behind and k >= 2:
+            assert err == pytest.approx(-14.0, abs=0.1), (k, err)
+        elif not behind and k >= 14:
+            assert abs(err) < 0.3, (k, err)

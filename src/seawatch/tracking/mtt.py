@@ -442,6 +442,7 @@ class MultiTargetTracker:
         self._next_id = next_id
         self._time: float | None = None
         self._anchored: tuple[NDArray[np.int64], FloatArray, NDArray[np.bool_]] | None = None
+        self._own: tuple[FloatArray, FloatArray] | None = None  # _own_boxes of this scan
         self._S: FloatArray | None = None
         self._boxes: bool | None = None
 
@@ -521,6 +522,7 @@ class MultiTargetTracker:
         zs = None if sizes is None else sizes[valid]
         edges = None  # tracks measured by the free edges of their boxes
         self._anchored = None  # the gate's anchored centres of this scan (_anchor_pairs)
+        self._own = self._own_boxes(z, zs) if zs is not None and self.occlusion else None
         self._S = None  # the predicted tracks' innovation covariances, once computed
         if zs is not None and self.occlusion and self._confirmed.any():
             edges = self._confirmed.copy()
@@ -820,6 +822,24 @@ class MultiTargetTracker:
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.where(smaller > 0.0, inter / smaller, 0.0)
 
+    def _own_boxes(self, z: FloatArray, sizes: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Per track, the box of this scan that is its own — the one with the largest
+        IoU with its predicted box, if that is 1/2 or more — as centre and size [px or
+        m] (NaN where none is)."""
+        c = np.full((self.n_tracks, _DIM), np.nan)
+        s = np.full((self.n_tracks, _DIM), np.nan)
+        if self.n_tracks == 0 or z.shape[0] == 0:
+            return c, s
+        area = np.prod(self._size, axis=1)[:, None]
+        inter = self._overlaps(np.arange(self.n_tracks), z, sizes, of_track=True) * area
+        with np.errstate(invalid="ignore", divide="ignore"):
+            iou = inter / (area + np.prod(sizes, axis=1)[None] - inter)
+        iou = np.nan_to_num(iou)
+        best = np.argmax(iou, axis=1)
+        ok = iou[np.arange(self.n_tracks), best] >= 0.5
+        c[ok], s[ok] = z[best[ok]], sizes[best[ok]]
+        return c, s
+
     def _tolerance(self, size: FloatArray) -> FloatArray:
         """How near [px or m] a box edge must come to a span or an extent to count as
         on it, per axis of ``size``: ``max(σ_z, 15 %)`` of the size (:data:`_EDGE_TOL`)."""
@@ -861,7 +881,11 @@ class MultiTargetTracker:
         track's size) inside the predicted span of another confirmed track that shares
         the track's span on the other axis and has at least a tenth of its area
         (:data:`_RESTART_GROWTH`; a wake or glint speck beside a ship blocks nothing):
-        it may be that ship's outline or the seam between two merged ships; the top edge
+        it may be that ship's outline or the seam between two merged ships — unless the
+        box spans the whole of that ship's span (on both axes, within the tolerance), that
+        ship has a box of its own in this scan (:meth:`_own_boxes`) and its water line is
+        not above the track's: then the box is no merge of the two but the track seen
+        around a ship in front of it, and its ends are its own; the top edge
         of a track with :data:`_SETTLED_HITS` detections is blocked too where the box's
         bottom is on the track's predicted one (within the tolerance) and its top lies
         above the track's by more than twice the tolerance (something behind the
@@ -904,6 +928,18 @@ class MultiTargetTracker:
             shares &= (oarea * _RESTART_GROWTH > area)[..., None]  # not a speck on a ship
             on_lo = shares & (olo - t <= lo[:, None]) & (lo[:, None] <= ohi + t)
             on_hi = shares & (olo - t <= hi[:, None]) & (hi[:, None] <= ohi + t)
+            if self._own is not None:
+                # a box around the whole of a ship not behind the track (its water line
+                # not above the track's) that has a box of its own this scan is no merge
+                # of the two: the track is seen around that ship, its ends are its own
+                oc_, os_ = self._own[0][others][None], self._own[1][others][None]
+                apart = np.all(np.isfinite(oc_), axis=2) & ~np.all(
+                    (np.abs(oc_ - dc[:, None]) < 0.5) & (np.abs(os_ - ds[:, None]) < 0.5), axis=2
+                )
+                around = np.all((lo[:, None] <= olo + t) & (hi[:, None] >= ohi - t), axis=2)
+                around &= apart & (ohi[..., 1] >= thi[..., 1])
+                on_lo[..., 0] &= ~around
+                on_hi[..., 0] &= ~around
             blocked_lo, blocked_hi = on_lo.any(axis=1), on_hi.any(axis=1)
             # an edge that every span blocking it blocks from in front (its water line
             # lower by more than the tolerance) at its near side (the box reaching at
