@@ -930,12 +930,11 @@ class MultiTargetTracker:
             on_hi = shares & (olo - t <= hi[:, None]) & (hi[:, None] <= ohi + t)
             if self._own is not None:
                 # a box around the whole of a ship not behind the track (its water line
-                # not above the track's) that has a box of its own this scan is no merge
-                # of the two: the track is seen around that ship, its ends are its own
-                oc_, os_ = self._own[0][others][None], self._own[1][others][None]
-                apart = np.all(np.isfinite(oc_), axis=2) & ~np.all(
-                    (np.abs(oc_ - dc[:, None]) < 0.5) & (np.abs(os_ - ds[:, None]) < 0.5), axis=2
-                )
+                # not above the track's) that has another box of its own this scan is no
+                # merge of the two: the track is seen around that ship, its ends are its own
+                own_c, own_s = self._own[0][others][None], self._own[1][others][None]
+                same = (np.abs(own_c - dc[:, None]) < 0.5) & (np.abs(own_s - ds[:, None]) < 0.5)
+                apart = np.all(np.isfinite(own_c), axis=2) & ~np.all(same, axis=2)
                 around = np.all((lo[:, None] <= olo + t) & (hi[:, None] >= ohi - t), axis=2)
                 around &= apart & (ohi[..., 1] >= thi[..., 1])
                 on_lo[..., 0] &= ~around
