@@ -69,6 +69,33 @@ def test_brief_jump_to_neighbour_stays_with_majority_object():
     assert np.all(np.isnan(per[:, 1]))
 
 
+def test_a_box_many_times_an_object_s_area_is_no_estimate_of_it():
+    """A ship (50 x 12 px) and a boat (7 x 2 px) 40 px to its left; a glitter track's
+    box (48 x 13 px) holds the boat in frames 0-49 while no track is on it, then the
+    boat's own track takes it in frames 50-99. By the sum of IoU (0.022 a frame) the
+    glitter track would belong to the boat and its 50 frames, 12 px off, would be the
+    boat's error (rendered lighting case); its box is 45 times the boat's area, so it
+    is no estimate of the boat: the boat is scored on its own track alone, and its
+    first 50 frames have no estimate. The boat's track, matched, is scored in every
+    frame, also where its box is off in scale (frame 99: 80 x 20 px, merged)."""
+    gt, est = [], []
+    for k in range(100):
+        gt += [[k, 1, 100.0, 200.0, 50, 12], [k, 2, 53.0, 205.0, 7, 2]]
+        if k < 50:
+            est.append([k, 5, 30.0, 200.0, 48, 13])  # holds the boat, centre 12.5 px off
+        else:
+            boat = [56.0, 205.0, 7, 2] if k < 99 else [20.0, 196.0, 80, 20]
+            est.append([k, 6, *boat])
+        est.append([k, 1, 100.0, 200.0, 50, 12])
+    r = centre_location_error(np.array(est, float), np.array(gt, float))
+    assert r.matches == {1: 1, 6: 2}
+    per = r.per_frame.reshape(100, 2)
+    assert np.all(np.isnan(per[:50, 1]))
+    assert per[50:99, 1] == pytest.approx(3.0)
+    assert per[99, 1] == pytest.approx(np.hypot(60.0 - 56.5, 206.0 - 206.0))
+    assert r.coverage == pytest.approx(150 / 200)
+
+
 def test_box_iou_closed_forms():
     assert box_iou([0, 0, 10, 10], [5, 0, 10, 10]) == pytest.approx(50 / 150)
     assert box_iou([0, 0, 10, 10], [20, 0, 10, 10]) == 0.0

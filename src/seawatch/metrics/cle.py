@@ -16,7 +16,11 @@ are reported (§1.6):
 Several objects: estimates and truth are MOT-style rows ``(frame, id, x, y, w, h)``.
 Each track id is matched to the truth object it overlaps most over the whole sequence
 (the largest sum of per-frame IoU; ties to the lower object id), so a track that
-briefly jumps to a neighbour still belongs to its ship. A truth object may own several
+briefly jumps to a neighbour still belongs to its ship. Only frames where the track's
+box is of the object's scale count (areas within :data:`SCALE_RATIO` of each other): a
+box tens of times larger than a small boat, that holds it (a track on sun glitter
+passing over it), is no estimate of the boat, however often it covers it; a track
+matched to the object is scored in all its frames. A truth object may own several
 track ids (a track lost and started again); in a frame where two of its tracks are
 present, the one with the larger IoU with the truth box is scored.
 """
@@ -30,7 +34,11 @@ from numpy.typing import ArrayLike
 
 from seawatch._validation import FloatArray, as_float_array, positive
 
-__all__ = ["CLEResult", "box_iou", "centre_location_error"]
+__all__ = ["SCALE_RATIO", "CLEResult", "box_iou", "centre_location_error"]
+
+SCALE_RATIO = 10.0
+"""Several objects: a track's box counts towards its match with an object only in the
+frames where their areas are within this factor of each other."""
 
 
 @dataclass(frozen=True)
@@ -141,8 +149,13 @@ def centre_location_error(
         iou = box_iou(est[ei, 2:], gt[gi, 2:])
         tids, t_inv = np.unique(est[ei, 1], return_inverse=True)
         oids, o_inv = np.unique(gt[gi, 1], return_inverse=True)
+        # a box over SCALE_RATIO times the object's area, or under its 1/SCALE_RATIO, is
+        # no estimate of that object (a glint track's box over a small boat): its
+        # overlap does not count towards the match
+        ae, ag = np.prod(est[ei, 4:6], axis=1), np.prod(gt[gi, 4:6], axis=1)
+        scaled = (ae <= SCALE_RATIO * ag) & (ag <= SCALE_RATIO * ae)
         total = np.zeros((tids.size, oids.size))
-        np.add.at(total, (t_inv, o_inv), iou)
+        np.add.at(total, (t_inv, o_inv), np.where(scaled, iou, 0.0))
         best = np.argmax(total, axis=1)  # ties: first (lowest) object id
         owned = total[np.arange(tids.size), best] > 0.0
         if single_g:  # one target: the estimate is its estimate whatever the overlap
