@@ -797,3 +797,25 @@ def test_occlusion_a_box_around_a_ship_with_its_own_box_is_the_track_s(behind):
             assert err == pytest.approx(-14.0, abs=0.1), (k, err)
         elif not behind and k >= 14:
             assert abs(err) < 0.3, (k, err)
+
+
+def test_a_box_of_another_scale_is_not_gated():
+    """A track on a 48 x 13 px box (sun glitter) coasts for two frames, and a 7 x 2 px
+    boat's box (1/45 of its area) appears 4 px from its predicted centre: it starts a
+    track of its own instead of being taken by the big one — which shrank onto the
+    boat and carried its id there (rendered lighting case) — and the big track keeps
+    its size. A box of the track's scale (half its area) at the same place is taken."""
+    for w, h, taken in ((7.0, 2.0, False), (34.0, 9.0, True)):
+        trk = _tracker(confirm_m=1, confirm_n=1, sigma_a=0.5, sigma_z=2.0, delete_after=5)
+        for k in range(10):
+            trk.step(np.array([[100.0 + k, 200.0, 48.0, 13.0]]))
+        for k in range(10, 12):
+            trk.step(None, float(k))
+        cx, cy = 124.0 + 12.0 + 4.0, 206.5
+        st = trk.step(np.array([[cx - 0.5 * w, cy - 0.5 * h, w, h]]), 12.0)
+        big = st.ids == 1
+        if taken:
+            assert st.ids.tolist() == [1]
+        else:
+            assert sorted(st.ids.tolist()) == [1, 2]
+            assert st.boxes[big, 2:][0] == pytest.approx([48.0, 13.0])

@@ -93,7 +93,7 @@ _N = 2 * _DIM  # state size [x, y, vx, vy]
 _RESTART_GROWTH = 10.0
 """Largest ratio of a detection's box area to a track's for the overlap stage's restart
 (a hull that gains its superstructure: a few times; a boat merged into the box of the
-ships passing in front of it: tens of times)."""
+ships passing in front of it: tens of times), and either way for the gate's pairs."""
 _EDGE_TOL = 0.15
 """Occlusion handling: a box edge within this fraction of a track's size (at least σ_z)
 of a span or an extent counts as on it (:meth:`MultiTargetTracker._tolerance`)."""
@@ -695,7 +695,10 @@ class MultiTargetTracker:
         among the ``tracks`` and ``dets`` marked True (default: all). A track marked in
         ``edges`` (``occlusion``) is gated on every detection with the centre it would
         be measured by (:meth:`_anchor`, box ``sizes``): of two ships with one centre,
-        each takes the box of its own size.
+        each takes the box of its own size. With box ``sizes`` a box over
+        :data:`_RESTART_GROWTH` times the track's area, or under its share, is not
+        gated: it is another object or a speck of this one (a track on sun glitter,
+        its box 30 times a small boat's, took the boat's box when it coasted over it).
 
         Candidate pairs come from a sort-and-sweep prefilter: ``d² <= gamma`` implies
         ``|y_x|, |y_y| <= sqrt(gamma · tr S)``, so only detections within that box of a
@@ -745,6 +748,10 @@ class MultiTargetTracker:
         # d² with the closed-form inverse of the 2 x 2 innovation covariances
         d2, detr = _mahalanobis2(S[rows], y)
         gated = d2 <= self.gate
+        if sizes is not None:  # a box of another scale is another object (or a speck of it)
+            area_t, area_d = np.prod(self._size[rows], axis=1), np.prod(sizes[cols], axis=1)
+            scaled = (area_d * _RESTART_GROWTH >= area_t) & (area_t * _RESTART_GROWTH >= area_d)
+            gated &= scaled | (area_t <= 0.0) | (area_d <= 0.0)  # no scale: no test
         if tracks is not None:
             gated &= tracks[rows]
         if dets is not None:
