@@ -19,8 +19,10 @@ Each track id is matched to the truth object it overlaps most over the whole seq
 briefly jumps to a neighbour still belongs to its ship. Only frames where the track's
 box is of the object's scale count (areas within :data:`SCALE_RATIO` of each other): a
 box tens of times larger than a small boat, that holds it (a track on sun glitter
-passing over it), is no estimate of the boat, however often it covers it; a track
-matched to the object is scored in all its frames. A truth object may own several
+passing over it), is no estimate of the boat, however often it covers it — nor is it
+scored as one in the frames of a track matched to the object (a glitter track that
+ends on the boat): those frames have no estimate (they fail the precision and lower
+the coverage). A truth object may own several
 track ids (a track lost and started again); in a frame where two of its tracks are
 present, the one with the larger IoU with the truth box is scored.
 """
@@ -37,8 +39,9 @@ from seawatch._validation import FloatArray, as_float_array, positive
 __all__ = ["SCALE_RATIO", "CLEResult", "box_iou", "centre_location_error"]
 
 SCALE_RATIO = 10.0
-"""Several objects: a track's box counts towards its match with an object only in the
-frames where their areas are within this factor of each other."""
+"""Several objects: a track's box is an estimate of an object (counts towards their
+match, and is scored) only in the frames where their areas are within this factor of
+each other."""
 
 
 @dataclass(frozen=True)
@@ -162,7 +165,7 @@ def centre_location_error(
             owned[:] = True
         for k in np.flatnonzero(owned):
             matches[int(tids[k])] = int(oids[best[k]])
-        mine = owned[t_inv] & (best[t_inv] == o_inv)
+        mine = owned[t_inv] & (best[t_inv] == o_inv) & (scaled | single_g)
         ei, gi, iou = ei[mine], gi[mine], iou[mine]
         # per truth row keep the owned estimate with the largest IoU
         pick = np.lexsort((-iou, gi))
