@@ -819,3 +819,18 @@ def test_a_box_of_another_scale_is_not_gated():
         else:
             assert sorted(st.ids.tolist()) == [1, 2]
             assert st.boxes[big, 2:][0] == pytest.approx([48.0, 13.0])
+
+
+def test_a_box_a_tenth_of_a_track_s_area_inside_it_does_not_restart_it():
+    """A track on a 48 x 13 px box and, in its next frame, only a 7 x 2 px box in its
+    box's corner, on its bottom edge (outside the position gate, inside the box): the
+    overlap stage restarted the track on it — its size 7 x 2 px, its centre 17 px away
+    (a glitter track jumping onto lighting's boat). A box under a tenth of the track's
+    area is a speck of its object or another object: a track of its own starts."""
+    trk = _tracker(confirm_m=1, confirm_n=1, overlap_gate=0.5)
+    for k in range(10):
+        trk.step(np.array([[100.0 + k, 200.0, 48.0, 13.0]]), float(k))
+    st = trk.step(np.array([[148.0, 211.0, 7.0, 2.0]]), 10.0)
+    assert st.ids.tolist() == [1, 2]
+    assert st.boxes[0].tolist() == pytest.approx([110.0, 200.0, 48.0, 13.0], abs=0.01)
+    assert st.boxes[1].tolist() == pytest.approx([148.0, 211.0, 7.0, 2.0])

@@ -788,9 +788,10 @@ class MultiTargetTracker:
         dc, ds = z[free_d], sizes[free_d]
         ov = self._overlaps(free_t, dc, ds)
         # a box many times larger than the track's is no re-segmentation of its ship but
-        # ships merged into one box (one passing in front of another): no restart
-        area_t = np.prod(self._size[free_t], axis=1)
-        ov[np.prod(ds, axis=1)[None] > _RESTART_GROWTH * area_t[:, None]] = 0.0
+        # ships merged into one box (one passing in front of another), and one many
+        # times smaller a speck of it or another object inside its box: no restart
+        area_t, area_d = np.prod(self._size[free_t], axis=1)[:, None], np.prod(ds, axis=1)[None]
+        ov[(area_d > _RESTART_GROWTH * area_t) | (_RESTART_GROWTH * area_d < area_t)] = 0.0
         # a confirmed ship's water line (its box's bottom edge) stays where it was: a box
         # whose bottom is elsewhere is a piece of it above the water (a superstructure,
         # a mast) or holds something below it (glint, a wake), not its re-segmentation
