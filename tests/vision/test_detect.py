@@ -602,25 +602,37 @@ def test_water_line_of_a_hull_seen_at_an_angle_lies_on_its_sloping_edge(refine):
     assert abs(v - (t[5] + slope * (u - t[4]))) <= 0.15  # on the edge, not its lowest end
 
 
+def _two_ships(seed: int, first: tuple, second: tuple, **detector):
+    """A sea scene with two ships drawn by :func:`box_ship` (``(cx, wl, length, hull,
+    contrast, sup)`` each), lens-blurred, noise 2 grey levels; returns the detections,
+    the truth rows and the index of each truth row's detection (no false box)."""
+    rng = np.random.default_rng(seed)
+    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
+    img = base.copy()
+    truth = np.array([box_ship(img, base, *first[:5], sup=first[5]),
+                      box_ship(img, base, *second[:5], sup=second[5])])  # fmt: skip
+    img = as_u8(cv2.GaussianBlur(img, (0, 0), 0.7) + rng.normal(0, 2.0, img.shape))
+    det = ClassicalShipDetector(**detector)(img, horizon=hz)
+    found, n_false = match(det, truth)
+    assert (found >= 0).all() and n_false == 0, det.boxes
+    return det, truth, found
+
+
+def _own_sides(det, truth: np.ndarray, found: np.ndarray) -> None:
+    """Each ship's box has its own left and right sides, within a pixel."""
+    np.testing.assert_allclose(det.x[found], truth[:, 0], atol=1.0)
+    np.testing.assert_allclose(det.x[found] + det.w[found], truth[:, 0] + truth[:, 2], atol=1.0)
+
+
 @pytest.mark.parametrize("refine", REFINE)
 def test_ship_in_front_of_another_gives_two_boxes_with_their_own_water_lines(refine):
     """A 40 px ship 2.3 px lower in the image (nearer) in front of a 90 px one: one
     connected object whose water line jumps; the committed detector gave one box (the
     far ship's) with a water line between the two."""
-    rng = np.random.default_rng(1234)
-    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
-    img = base.copy()
-    far = box_ship(img, base, 300.0, 200.4, 90, 7, -45, sup=(1 / 3, 6))
-    near = box_ship(img, base, 310.0, 202.7, 40, 8, -70, sup=(0, 0))
-    img = as_u8(cv2.GaussianBlur(img, (0, 0), 0.7) + rng.normal(0, 2.0, img.shape))
-    det = ClassicalShipDetector(refine=refine)(img, horizon=hz)
-    truth = np.array([far, near])
-    found, n_false = match(det, truth)
-    assert (found >= 0).all() and n_false == 0
+    far, near = (300.0, 200.4, 90, 7, -45, (1 / 3, 6)), (310.0, 202.7, 40, 8, -70, (0, 0))
+    det, truth, found = _two_ships(1234, far, near, refine=refine)
     np.testing.assert_allclose(det.v_wl[found], truth[:, 5], atol=0.2)
-    # the far ship spans the near one; each box's sides are its own
-    np.testing.assert_allclose(det.x[found], truth[:, 0], atol=1.0)
-    np.testing.assert_allclose(det.x[found] + det.w[found], truth[:, 0] + truth[:, 2], atol=1.0)
+    _own_sides(det, truth, found)  # the far ship spans the near one
 
 
 @pytest.mark.parametrize("seed", [1234, 99])
@@ -629,19 +641,10 @@ def test_ship_one_pixel_nearer_than_the_one_behind_it_gives_two_boxes(seed):
     of a 90 px one, the overtaking case's geometry at 960×540): two boxes, each with its
     own water line and sides. With the 1 px jump for every split (before) they were one
     box: the running medians put the step at 0.9–1.0 px."""
-    rng = np.random.default_rng(seed)
-    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
-    img = base.copy()
-    far = box_ship(img, base, 300.0, 200.4, 90, 7, -45, sup=(1 / 3, 6))
-    near = box_ship(img, base, 280.0, 201.4, 40, 8, -70, sup=(0, 0))
-    img = as_u8(cv2.GaussianBlur(img, (0, 0), 0.7) + rng.normal(0, 2.0, img.shape))
-    det = ClassicalShipDetector()(img, horizon=hz)
-    truth = np.array([far, near])
-    found, n_false = match(det, truth)
-    assert (found >= 0).all() and n_false == 0, det.boxes
+    far, near = (300.0, 200.4, 90, 7, -45, (1 / 3, 6)), (280.0, 201.4, 40, 8, -70, (0, 0))
+    det, truth, found = _two_ships(seed, far, near)
     np.testing.assert_allclose(det.v_wl[found], truth[:, 5], atol=0.2)
-    np.testing.assert_allclose(det.x[found], truth[:, 0], atol=1.0)
-    np.testing.assert_allclose(det.x[found] + det.w[found], truth[:, 0] + truth[:, 2], atol=1.0)
+    _own_sides(det, truth, found)
 
 
 @pytest.mark.parametrize("gap", [5.0, 7.0, 9.0])
@@ -653,18 +656,8 @@ def test_two_ships_side_by_side_are_split_at_the_sea_between_them(gap):
     fell one column into the boat, and the two were one box (72-76 px) in all three
     cases. (Other noise draws: seed 99 still gives one box at 5 and 7 px, seed 7 boxes
     the ship 8-10 px into the sea at 7 and 9 px.)"""
-    rng = np.random.default_rng(1234)
-    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
-    img = base.copy()
-    ship = box_ship(img, base, 300.0, 200.4, 40, 5, -45, sup=(0.6, 4))
-    boat = box_ship(img, base, 333.0 + gap, 201.5, 26, 6, -70, sup=(0, 0))
-    img = as_u8(cv2.GaussianBlur(img, (0, 0), 0.7) + rng.normal(0, 2.0, img.shape))
-    det = ClassicalShipDetector()(img, horizon=hz)
-    truth = np.array([ship, boat])
-    found, n_false = match(det, truth)
-    assert (found >= 0).all() and n_false == 0, det.boxes
-    np.testing.assert_allclose(det.x[found], truth[:, 0], atol=1.0)
-    np.testing.assert_allclose(det.x[found] + det.w[found], truth[:, 0] + truth[:, 2], atol=1.0)
+    ship, boat = (300.0, 200.4, 40, 5, -45, (0.6, 4)), (333.0 + gap, 201.5, 26, 6, -70, (0, 0))
+    _own_sides(*_two_ships(1234, ship, boat))
 
 
 @pytest.mark.parametrize("refine", REFINE)
