@@ -6,8 +6,10 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from seawatch.metrics.cle import box_iou, centre_location_error
+from seawatch.metrics.cle import SCALE_RATIO, box_iou, centre_location_error
 
 
 def test_single_target_cle_matches_hand_computed_3_4_5_offsets():
@@ -95,6 +97,35 @@ def test_a_box_many_times_an_object_s_area_is_no_estimate_of_it():
     assert per[50:99, 1] == pytest.approx(3.0)
     assert np.isnan(per[99, 1])
     assert r.coverage == pytest.approx(149 / 200)
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(
+    w=st.floats(2.0, 60.0),
+    h=st.floats(1.0, 20.0),
+    scale=st.floats(1.05, 40.0),
+    aspect=st.floats(0.5, 2.0),
+    dx=st.floats(-0.5, 0.5),
+    dy=st.floats(-0.5, 0.5),
+)
+def test_a_track_is_matched_to_an_object_only_at_its_scale(w, h, scale, aspect, dx, dy):
+    """Property of the several-object match: a track's box that holds a lone object
+    (its area ``scale`` times the object's, its centre shifted by up to a quarter of
+    its size) is matched to the object, and scored, exactly when the areas are within
+    SCALE_RATIO of each other; else the object has no estimate at all."""
+    tw = w * np.sqrt(scale * aspect)
+    th = h * np.sqrt(scale / aspect)
+    cx, cy = 200.0 + 0.5 * w, 100.0 + 0.5 * h
+    gt = np.array([[k, 1, 200.0, 100.0, w, h] for k in range(5)], float)
+    ox, oy = cx + dx * 0.5 * (tw - w), cy + dy * 0.5 * (th - h)  # the box holds the object
+    est = np.array([[k, 3, ox - 0.5 * tw, oy - 0.5 * th, tw, th] for k in range(5)], float)
+    r = centre_location_error(est, gt)
+    if scale <= SCALE_RATIO:
+        assert r.matches == {3: 1}
+        assert r.per_frame == pytest.approx(np.full(5, np.hypot(ox - cx, oy - cy)))
+    else:
+        assert r.matches == {}
+        assert np.all(np.isnan(r.per_frame)) and r.coverage == 0.0
 
 
 def test_box_iou_closed_forms():
