@@ -834,3 +834,28 @@ def test_a_box_a_tenth_of_a_track_s_area_inside_it_does_not_restart_it():
     assert st.ids.tolist() == [1, 2]
     assert st.boxes[0].tolist() == pytest.approx([110.0, 200.0, 48.0, 13.0], abs=0.01)
     assert st.boxes[1].tolist() == pytest.approx([148.0, 211.0, 7.0, 2.0])
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(
+    w=st.floats(6.0, 80.0),
+    h=st.floats(3.0, 20.0),
+    ratio=st.floats(0.02, 50.0),
+    aspect=st.floats(0.5, 2.0),
+)
+def test_a_box_at_the_prediction_is_taken_only_at_the_track_s_scale(w, h, ratio, aspect):
+    """Property of the scale gate: a settled track (10 detections, 1 px/frame) meets, at
+    its predicted centre, one box of ``ratio`` times its area: the track takes it (one
+    id) exactly when the ratio is within _RESTART_GROWTH = 10 either way; else the box
+    starts a track of its own and the first one keeps its size."""
+    trk = _tracker(confirm_m=1, confirm_n=1, sigma_a=0.5, sigma_z=2.0, delete_after=5)
+    for k in range(10):
+        trk.step(np.array([[100.0 + k, 200.0, w, h]]), float(k))
+    bw, bh = w * np.sqrt(ratio * aspect), h * np.sqrt(ratio / aspect)
+    cx, cy = 110.0 + 0.5 * w, 200.0 + 0.5 * h
+    st_ = trk.step(np.array([[cx - 0.5 * bw, cy - 0.5 * bh, bw, bh]]), 10.0)
+    if 1.0 / 10.0 <= ratio <= 10.0:
+        assert st_.ids.tolist() == [1]
+    else:
+        assert st_.ids.tolist() == [1, 2]
+        assert st_.boxes[0, 2:].tolist() == pytest.approx([w, h], abs=1e-6)
