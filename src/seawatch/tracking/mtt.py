@@ -94,6 +94,14 @@ _RESTART_GROWTH = 10.0
 """Largest ratio of a detection's box area to a track's for the overlap stage's restart
 (a hull that gains its superstructure: a few times; a boat merged into the box of the
 ships passing in front of it: tens of times), and either way for the gate's pairs."""
+
+
+def _same_scale(area_a: FloatArray, area_b: FloatArray) -> NDArray[np.bool_]:
+    """Whether box areas [px² or m²] are within :data:`_RESTART_GROWTH` of each other,
+    either way (broadcast): a box of another scale is another object or a speck of one."""
+    return (area_a <= _RESTART_GROWTH * area_b) & (area_b <= _RESTART_GROWTH * area_a)
+
+
 _EDGE_TOL = 0.15
 """Occlusion handling: a box edge within this fraction of a track's size (at least σ_z)
 of a span or an extent counts as on it (:meth:`MultiTargetTracker._tolerance`)."""
@@ -522,10 +530,11 @@ class MultiTargetTracker:
         zs = None if sizes is None else sizes[valid]
         edges = None  # tracks measured by the free edges of their boxes
         self._anchored = None  # the gate's anchored centres of this scan (_anchor_pairs)
-        self._own = self._own_boxes(z, zs) if zs is not None and self.occlusion else None
+        self._own = None  # the tracks' own boxes of this scan (_own_boxes), for _anchor
         self._S = None  # the predicted tracks' innovation covariances, once computed
         if zs is not None and self.occlusion and self._confirmed.any():
             edges = self._confirmed.copy()
+            self._own = self._own_boxes(z, zs)
         if self.confirmed_first:
             rows, cols, r2, c2 = self._cascade(z, zs if boxes else None, zs, edges)
         else:
@@ -750,8 +759,7 @@ class MultiTargetTracker:
         gated = d2 <= self.gate
         if sizes is not None:  # a box of another scale is another object (or a speck of it)
             area_t, area_d = np.prod(self._size[rows], axis=1), np.prod(sizes[cols], axis=1)
-            scaled = (area_d * _RESTART_GROWTH >= area_t) & (area_t * _RESTART_GROWTH >= area_d)
-            gated &= scaled | (area_t <= 0.0) | (area_d <= 0.0)  # no scale: no test
+            gated &= _same_scale(area_t, area_d) | (area_t <= 0.0) | (area_d <= 0.0)
         if tracks is not None:
             gated &= tracks[rows]
         if dets is not None:
@@ -791,7 +799,7 @@ class MultiTargetTracker:
         # ships merged into one box (one passing in front of another), and one many
         # times smaller a speck of it or another object inside its box: no restart
         area_t, area_d = np.prod(self._size[free_t], axis=1)[:, None], np.prod(ds, axis=1)[None]
-        ov[(area_d > _RESTART_GROWTH * area_t) | (_RESTART_GROWTH * area_d < area_t)] = 0.0
+        ov[~_same_scale(area_t, area_d)] = 0.0
         # a confirmed ship's water line (its box's bottom edge) stays where it was: a box
         # whose bottom is elsewhere is a piece of it above the water (a superstructure,
         # a mast) or holds something below it (glint, a wake), not its re-segmentation
