@@ -924,6 +924,29 @@ def _fine_bins(width: int) -> tuple[int, int]:
     return bin_w, -(-width // bin_w)
 
 
+def _line_profiles(
+    arr: np.ndarray, y0: float, y1: float, R: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Step 6's column-bin profiles (:func:`_fine_profiles`, bins :func:`_fine_bins`)
+    of ``arr`` across the line (y0, y1) [full px], ``R`` px either side: from the band of
+    rows around the line as float32 luma (one compiled kernel for every input type; for
+    colour, vectorised luma is cheaper than weighting the channels pixel by pixel), or,
+    for a steep line in a colour image, from the whole image. Returns ``(prof, rbar,
+    xbar, cnt)`` with ``rbar`` in image rows [px]."""
+    H, W = arr.shape[:2]
+    t = (y1 - y0) / (W - 1)
+    bin_w, nb = _fine_bins(W)
+    top = max(0, math.floor(min(y0, y1) + 0.5) - R)
+    bottom = min(H, math.floor(max(y0, y1) + 0.5) + R + 1)
+    if arr.ndim == 2 or 0 < bottom - top <= 3 * (2 * R + 1):
+        band = arr[top:bottom] if arr.ndim == 2 else cv2.cvtColor(arr[top:bottom], _BGR2GREY)
+        img, wts, y_top = band.astype(np.float32).reshape(-1, W, 1), _LUMA_GREY, top
+    else:
+        img, wts, y_top = arr, _LUMA_BGR, 0  # a steep line in a colour image
+    prof, rbar, xbar, cnt = _fine_profiles(img, wts, y0 - y_top, t, R, bin_w, nb)
+    return prof, rbar + y_top, xbar, cnt
+
+
 @dataclass(frozen=True)
 class _Fine:
     """Step 6's refined line: rows ``y0``, ``y1`` at the first and last column [px], the
@@ -985,28 +1008,17 @@ def _fine_line(
     coordinates ``(c, t, strip width)``: the expected polarity of each bin is the sign
     of ``P`` at the line; the error of the coarse line is about a working row.
     """
-    H, W = arr.shape[:2]
+    W = arr.shape[1]
     t = (y1 - y0) / (W - 1)
     S = math.ceil(1.25 * sy) + 1  # search half-range of the edge [px]
     g_max = max(3, math.ceil(sy))  # largest transition half-window [px]
     R = S + 2 * g_max + 1
-    bin_w, nb = _fine_bins(W)
-    top = max(0, math.floor(min(y0, y1) + 0.5) - R)
-    bottom = min(H, math.floor(max(y0, y1) + 0.5) + R + 1)
-    if arr.ndim == 2 or 0 < bottom - top <= 3 * (2 * R + 1):
-        # the band of rows around the line as float32 luma (one compiled kernel for
-        # every input type; for colour, vectorised luma is cheaper than weighting the
-        # channels pixel by pixel)
-        band = arr[top:bottom] if arr.ndim == 2 else cv2.cvtColor(arr[top:bottom], _BGR2GREY)
-        img, wts, y_top = band.astype(np.float32).reshape(-1, W, 1), _LUMA_GREY, top
-    else:
-        img, wts, y_top = arr, _LUMA_BGR, 0  # a steep line in a colour image
-    prof, rbar, xbar, cnt = _fine_profiles(img, wts, y0 - y_top, t, R, bin_w, nb)
+    prof, rbar, xbar, cnt = _line_profiles(arr, y0, y1, R)
     pol = _strip_polarity(P, xbar, sx, cw[2], cw[0], cw[1])
     dev = 2.0 * sy + 1.0  # largest correction at the ends: two working rows [px]
     s_max = max(_FINE_SCALE[1], 0.25 * sy)
     n0, n1, support, ex, ey = _fine_fit(
-        prof, rbar + y_top, xbar, cnt, pol, R, S, g_max, y0, t, 0.5 * (W - 1), s_max, dev
+        prof, rbar, xbar, cnt, pol, R, S, g_max, y0, t, 0.5 * (W - 1), s_max, dev
     )
     if not (math.isfinite(n0) and support >= _FINE_MIN_SUPPORT):
         return None
@@ -1022,19 +1034,12 @@ def _edges_below(
     it, with step 6's sub-pixel row and signal-to-noise test; the edge points (column,
     row) [px]. The sea horizon under a coast lies at or below a line along the coast's
     top, as far below as the coast is high."""
-    H, W = arr.shape[:2]
-    t = (y1 - y0) / (W - 1)
     S = math.ceil(0.5 * depth) + 2  # search half-range about the band's middle [px]
     g_max = max(3, math.ceil(sy))
     R = S + 2 * g_max + 1
-    bin_w, nb = _fine_bins(W)
-    yc = y0 + 0.5 * depth
-    top = max(0, math.floor(min(yc, yc + t * (W - 1)) + 0.5) - R)
-    bottom = min(H, math.floor(max(yc, yc + t * (W - 1)) + 0.5) + R + 1)
-    band = arr[top:bottom] if arr.ndim == 2 else cv2.cvtColor(arr[top:bottom], _BGR2GREY)
-    img = band.astype(np.float32).reshape(-1, W, 1)
-    prof, rbar, xbar, _ = _fine_profiles(img, _LUMA_GREY, yc - top, t, R, bin_w, nb)
-    x, y, _ = _fine_points(prof, rbar + top, xbar, np.full(nb, polarity), R, S, g_max)
+    prof, rbar, xbar, _ = _line_profiles(arr, y0 + 0.5 * depth, y1 + 0.5 * depth, R)
+    pol = np.full(prof.shape[0], polarity)
+    x, y, _ = _fine_points(prof, rbar, xbar, pol, R, S, g_max)
     return x, y
 
 
