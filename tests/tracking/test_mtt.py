@@ -859,3 +859,40 @@ def test_a_box_at_the_prediction_is_taken_only_at_the_track_s_scale(w, h, ratio,
     else:
         assert st_.ids.tolist() == [1, 2]
         assert st_.boxes[0, 2:].tolist() == pytest.approx([w, h], abs=1e-6)
+
+
+def test_occlusion_a_settled_ship_keeps_its_width_behind_a_boat_at_its_end():
+    """A ship A (40 × 9 px, water line at row 209) tracked alone for 30 frames; a boat B
+    (26 × 11 px, water line 210, in front) then comes in from the left and stays over A's
+    left 10 px, and the detector boxes B alone and, from B's left end to A's right one,
+    both (up to 66 px wide). The box spans
+    the whole of B, which has a box of its own — as in a bow-to-bow start, where the
+    shared end is the track's — but A's width is known (25 detections and more): a box
+    wider than it by more than the tolerance has the end it shares with B from B, and
+    A is measured by its free right end and its width (meeting case, seed 1, frame 130:
+    the ferry's track took the 46-px box of both and kept a width of 41.5 px for its 39.6
+    px, 2 px off, for 50 frames)."""
+    trk = _tracker(
+        confirm_m=3,
+        confirm_n=5,
+        occlusion=True,
+        overlap_gate=0.5,
+        sigma_a=0.5,
+        sigma_z=2.0,
+        sigma_z_rel=0.03,
+    )
+    for k in range(60):
+        a_left = 100.0 + 0.2 * k
+        boxes = [[a_left, 200.0, 40.0, 9.0]]
+        if k >= 30:
+            b_left = a_left - 40.0 + min(1.2 * (k - 30), 24.0)  # B stops over A's left 10 px
+            boxes.append([b_left, 199.0, 26.0, 11.0])
+            if b_left + 26.0 > a_left:  # B in front of A's left end: one box of both
+                boxes[0] = [b_left, 199.0, a_left + 40.0 - b_left, 11.0]
+        st = trk.step(np.array(boxes))
+        a = st.ids == 1
+        assert st.confirmed[a][0] or k < 3
+        if k >= 3:
+            err = a_left + 20.0 - st.states[a, 0][0]
+            assert abs(err) < 0.5, (k, err)
+            assert st.boxes[a, 2][0] == pytest.approx(40.0, abs=0.5), k

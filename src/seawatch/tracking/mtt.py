@@ -901,7 +901,10 @@ class MultiTargetTracker:
         box spans the whole of that ship's span (on both axes, within the tolerance), that
         ship has a box of its own in this scan (:meth:`_own_boxes`) and its water line is
         not above the track's: then the box is no merge of the two but the track seen
-        around a ship in front of it, and its ends are its own; the top edge
+        around a ship in front of it, and its ends are its own — except for a track with
+        :data:`_SETTLED_HITS` detections whose box is wider than its remembered width by
+        more than the tolerance: its width is known, and the end the box shares with
+        the ship in front is that ship's (the track's own end hidden behind it); the top edge
         of a track with :data:`_SETTLED_HITS` detections is blocked too where the box's
         bottom is on the track's predicted one (within the tolerance) and its top lies
         above the track's by more than twice the tolerance (something behind the
@@ -953,6 +956,11 @@ class MultiTargetTracker:
                 apart = np.all(np.isfinite(own_c), axis=2) & ~np.all(same, axis=2)
                 around = np.all((lo[:, None] <= olo + t) & (hi[:, None] >= ohi - t), axis=2)
                 around &= apart & (ohi[..., 1] >= thi[..., 1])
+                # a settled track whose box is wider than its width by more than the
+                # tolerance: the end that the box shares with the ship in front may be
+                # that ship's (the track's own end hidden behind it)
+                wider = (self._hits[rows] >= _SETTLED_HITS) & (ds[:, 0] - s[:, 0] > tol[:, 0])
+                around &= ~wider[:, None]
                 on_lo[..., 0] &= ~around
                 on_hi[..., 0] &= ~around
             blocked_lo, blocked_hi = on_lo.any(axis=1), on_hi.any(axis=1)
