@@ -77,6 +77,34 @@ def test_multi_axis_state_is_positions_first_and_axes_independent():
     np.testing.assert_array_equal((F @ x)[:3], [6.0, 12.0, 18.0])
 
 
+@given(
+    T=st.floats(0.01, 5.0),
+    sigmas=st.lists(st.floats(0.0, 10.0), min_size=1, max_size=3),
+    noise=st.sampled_from(["discrete", "continuous"]),
+)
+def test_per_axis_noise_is_each_axis_own_single_axis_model(T, sigmas, noise):
+    """A per-axis sigma_a (an image track's horizontal and vertical acceleration noise):
+    on each axis the single-axis model with that axis's sigma, no cross-axis terms."""
+    dim = len(sigmas)
+    F, Q = constant_velocity(dim, T, sigmas, noise=noise)
+    F_iso, _ = constant_velocity(dim, T, 1.0, noise=noise)
+    np.testing.assert_array_equal(F, F_iso)
+    for axis, s in enumerate(sigmas):
+        idx = [axis, axis + dim]
+        _, Q1 = constant_velocity(1, T, s, noise=noise)
+        np.testing.assert_allclose(Q[np.ix_(idx, idx)], Q1, rtol=1e-12, atol=0.0)
+    off = np.ones_like(Q, bool)
+    for axis in range(dim):
+        off[np.ix_([axis, axis + dim], [axis, axis + dim])] = False
+    assert not Q[off].any()
+
+
+@pytest.mark.parametrize("sigma", [[1.0], [1.0, 2.0, 3.0], [1.0, -0.5], [1.0, float("nan")]])
+def test_a_per_axis_noise_of_the_wrong_length_or_sign_raises_naming_sigma_a(sigma):
+    with pytest.raises(ValueError, match=r"^sigma_a: expected a number >= 0 or 2"):
+        constant_velocity(2, 0.1, sigma)
+
+
 @pytest.mark.parametrize(
     ("args", "name"),
     [

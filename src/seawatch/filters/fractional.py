@@ -676,7 +676,7 @@ class FractionalKalmanFilter:
         cls,
         *,
         dt: float = 1.0,
-        sigma_a: float = 1.0,
+        sigma_a: float | ArrayLike = 1.0,
         sigma_z: float = 2.0,
         sigma_v0: float = 5.0,
         order: ArrayLike = 0.95,
@@ -696,7 +696,7 @@ class FractionalKalmanFilter:
             dt: frame period in the velocity time unit (1.0: velocities in px/frame;
                 1/25 s: px/s at 25 fps).
             sigma_a: acceleration noise std [px/frame^2 with dt = 1] (seed 001 ships at
-                25 fps: 0.5–2).
+                25 fps: 0.5–2), one for both axes or ``(u, v)``.
             sigma_z: box-centre jitter of the detector/tracker [px].
             sigma_v0: initial velocity std ≈ expected maximum speed [px/frame].
             order, memory: fractional order(s) and history length L.

@@ -11,6 +11,7 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from seawatch._validation import FloatArray, integer, positive
 
@@ -22,6 +23,20 @@ def _check(dim: int, dt: float, sigma: float, sigma_name: str) -> tuple[int, flo
     return int(dim), positive("dt", dt), positive(sigma_name, sigma, allow_zero=True)
 
 
+def axis_sigmas(dim: int, sigma: float | ArrayLike, name: str) -> float | FloatArray:
+    """A noise level for every spatial axis: ``sigma`` itself if it is one number (>= 0),
+    else an array of ``dim`` numbers (>= 0, finite), one per axis (e.g. an image track's
+    horizontal and vertical acceleration noise)."""
+    if np.ndim(sigma) == 0:
+        return positive(name, float(sigma), allow_zero=True)  # type: ignore[arg-type]
+    s = np.asarray(sigma, dtype=float)
+    if s.shape != (dim,) or not np.all(np.isfinite(s)) or np.any(s < 0.0):
+        raise ValueError(
+            f"{name}: expected a number >= 0 or {dim} of them (one per axis), got {sigma!r}"
+        )
+    return s
+
+
 def _noise(noise: str) -> str:
     if noise not in ("discrete", "continuous"):
         raise ValueError(f"noise: expected 'discrete' or 'continuous', got {noise!r}")
@@ -29,7 +44,7 @@ def _noise(noise: str) -> str:
 
 
 def constant_velocity(
-    dim: int, dt: float, sigma_a: float, *, noise: NoiseKind = "discrete"
+    dim: int, dt: float, sigma_a: float | ArrayLike, *, noise: NoiseKind = "discrete"
 ) -> tuple[FloatArray, FloatArray]:
     """Transition matrix F and process noise Q of the NCV model.
 
@@ -45,13 +60,19 @@ def constant_velocity(
     Args:
         dim: number of spatial axes (1–3).
         dt: sampling interval T [s].
-        sigma_a: acceleration noise level (see above).
+        sigma_a: acceleration noise level (see above), one for all axes or one per axis
+            (``dim`` numbers: ``Q = kron(Q_unit, diag(sigma_a^2))``).
         noise: "discrete" (default) or "continuous".
 
     Returns:
         (F, Q), each of shape (2*dim, 2*dim).
     """
-    dim, T, s = _check(dim, dt, sigma_a, "sigma_a")
+    per_axis = axis_sigmas(integer("dim", dim, 1, 3), sigma_a, "sigma_a")
+    if np.ndim(per_axis):  # Q_unit's axes scaled: kron(Q1, I) has no cross-axis terms
+        F, Q = constant_velocity(dim, dt, 1.0, noise=noise)
+        t = np.tile(per_axis, 2)
+        return F, Q * np.outer(t, t)
+    dim, T, s = _check(dim, dt, sigma_a, "sigma_a")  # type: ignore[arg-type]
     F1 = np.array([[1.0, T], [0.0, 1.0]])
     if _noise(noise) == "discrete":
         g = np.array([T * T / 2.0, T])

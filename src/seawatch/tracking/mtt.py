@@ -78,7 +78,7 @@ from scipy.stats import chi2
 from seawatch._validation import FloatArray, as_float_array, in_range, integer, positive
 from seawatch.filters.fractional import FractionalKalmanFilter
 from seawatch.filters.kalman import KalmanFilter
-from seawatch.models.kinematic import constant_velocity, position_measurement
+from seawatch.models.kinematic import axis_sigmas, constant_velocity, position_measurement
 
 __all__ = [
     "MultiTargetTracker",
@@ -292,7 +292,7 @@ class MultiTargetTracker:
             Gating uses each track's predicted ``P`` with the tracker's ``H`` and ``R``.
         dt: nominal scan interval [s or frames] (used when ``step`` gets no time).
         sigma_a: acceleration noise of the CV model [units/dt²] (discrete white-noise
-            acceleration, ALGORITHMS.md §5.2).
+            acceleration, ALGORITHMS.md §5.2): one for both axes, or one per axis.
         sigma_z: measurement noise of a detection position [px or m] (``R = σ_z² I``).
         sigma_z_rel: boxes only — the box-centre noise of a large box, as a fraction k
             of its width and height [–]: ``σ = max(σ_z, k · size)`` per axis (module
@@ -346,7 +346,7 @@ class MultiTargetTracker:
         filter_factory: type | FilterFactory | None = None,
         *,
         dt: float = 1.0,
-        sigma_a: float = 0.5,
+        sigma_a: float | ArrayLike = 0.5,
         sigma_z: float = 2.0,
         sigma_v0: float = 10.0,
         gate_probability: float = 0.99,
@@ -363,7 +363,7 @@ class MultiTargetTracker:
         sigma_z_rel: float = 0.0,
     ) -> None:
         self.dt = positive("dt", dt)
-        self.sigma_a = positive("sigma_a", sigma_a, allow_zero=True)
+        self.sigma_a = axis_sigmas(_DIM, sigma_a, "sigma_a")
         self.sigma_z = positive("sigma_z", sigma_z)
         self.sigma_v0 = positive("sigma_v0", sigma_v0)
         self.sigma_z_rel = positive("sigma_z_rel", sigma_z_rel, allow_zero=True)
