@@ -268,7 +268,7 @@ def _detect(clip: Clip) -> int:
 def _stage(clip: Clip, keep: list[FloatArray] | None = None) -> int:
     from seawatch.vision.tracker import VisualTracker
 
-    vt = VisualTracker(fps=clip.fps)
+    vt = VisualTracker(fps=clip.fps, stabilise=False)  # as the track job runs it (pipeline)
     n = 0
     for fr, _, detections in vt.stream(_frames(clip)):
         rows = vt.update(detections)

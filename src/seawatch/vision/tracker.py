@@ -18,6 +18,19 @@ Issue 6, "Visual tracking"; ALGORITHMS.md §1.3–1.5. Per frame:
 3. confirmed tracks are reported, also while they coast on their prediction through a
    short occlusion or missed detections (up to ``delete_after`` frames).
 
+With ``stabilise`` (default) each box is tracked in horizon-stabilised rows: its row
+less how far the horizon's row at its column has moved since the first horizon taken,
+and reported back in the frame's own rows. The camera's pitch and roll sway moves every
+distant ship with the horizon, so it leaves the stabilised rows, where a ship's vertical
+motion is its slow change of depression: the vertical acceleration noise is a fifth of
+the horizontal by default (``sigma_a`` = (0.5, 0.1) px/frame² when the frames come with
+horizons, 0.5 for both axes when they do not). The line is the frame's horizon
+(:meth:`VisualTracker.horizon`, queued by :meth:`VisualTracker.stream` and
+:meth:`VisualTracker.step`, or given to :meth:`VisualTracker.update`), taken once it has
+settled (:data:`LINE_SETTLE`) and where it follows the lines before it
+(:data:`LINE_GATE`); a frame whose horizon jumps or is not found takes their linear
+prediction. Until the first line is taken the rows are the frame's.
+
 With ``motion`` (default) a moving camera's image shift is taken out first
 (:class:`~seawatch.vision.motion.CameraMotion`, measured on each frame where its horizon
 is found): the tracker filters the boxes in the first frame's coordinates (pixel minus
@@ -54,6 +67,7 @@ from seawatch.vision.motion import CameraMotion
 __all__ = [
     "DEFAULT_ORDER",
     "FILTERS",
+    "STABILISED_SIGMA_A",
     "TRACK_COLUMNS",
     "VisualTracker",
     "frames_lost",
@@ -65,12 +79,30 @@ TRACK_COLUMNS: tuple[str, ...] = ("id", "x", "y", "w", "h", "u_wl", "v_wl", "mis
 height h [px], water-line point u_wl, v_wl [px], consecutive missed detections [frames]."""
 
 _FIND = object()  # detect(): find the horizon of the frame
+_QUEUED = object()  # update(): the horizon queued for the frame
 
 READ_THREAD = "seawatch-read"
 """Name of :meth:`VisualTracker.stream`'s thread that decodes, finds the horizon and
 prepares each frame."""
 DETECT_THREAD = "seawatch-detect"
 """Name of :meth:`VisualTracker.stream`'s thread that detects the ships."""
+
+LINE_GATE = 1.0
+"""Largest step [px] of the horizon's rows (at the image's ends) from the last two lines'
+linear prediction that the stabilised rows follow (:class:`VisualTracker`): a camera's
+sway moves it by a fraction of that per frame (the rendered cases: 0.13 px at most; a
+small boat pitching 2° at 4 s: 0.14 px/frame² at 1000 px focal length)."""
+LINE_HOLD = 5
+"""Frames a horizon outside :data:`LINE_GATE` is held back before it is taken."""
+LINE_SETTLE = 3
+"""Consecutive horizons within :data:`LINE_GATE` of the two before them after which the
+rows are stabilised at all (a horizon tracker still converging — the rendered lighting
+case's second rendering: 20 px off at one end in its first frames — would move every
+track)."""
+
+STABILISED_SIGMA_A: tuple[float, float] = (0.5, 0.1)
+"""Default acceleration noise (horizontal, vertical) [px/frame²] of a box centre in
+horizon-stabilised rows (:class:`VisualTracker`, ``stabilise=True``; 0.5 for both without)."""
 
 DEFAULT_ORDER = 0.95
 """Default fractional order alpha of the AFKF/FKF (ALGORITHMS.md §1.3: tunable 0.8–1.0)."""
@@ -115,7 +147,11 @@ class VisualTracker:
         order: fractional order alpha of afkf/fkf (ALGORITHMS.md §1.3;
             :data:`DEFAULT_ORDER`).
         memory: GL history length L of afkf/fkf (default 30).
-        sigma_a: acceleration noise of the box centre [px/frame²] (Q0, §1.3).
+        sigma_a: acceleration noise of the box centre [px/frame²] (Q0, §1.3): one for
+            both axes or ``(horizontal, vertical)``; None: :data:`STABILISED_SIGMA_A`,
+            (0.5, 0.1), when the first frame tracked comes with a horizon (``horizon``
+            on, or one given to :meth:`update` / :meth:`track_detections`) and
+            ``stabilise`` is on — the vertical in horizon-stabilised rows —, else 0.5.
         sigma_z: box-centre jitter of the detector [px] (R = σ_z² I).
         sigma_z_rel: the jitter of a large box as a fraction k of its size:
             ``R = diag(max(σ_z, k w)², max(σ_z, k h)²)`` with the track's smoothed size
@@ -147,6 +183,8 @@ class VisualTracker:
             in front); its water-line offset is then not updated.
         min_score: detections with a lower score are ignored.
         horizon: estimate the horizon per frame and give it to the detector (sea region).
+        stabilise: track the boxes in horizon-stabilised rows (module docstring); while
+            no horizon has been found the rows are the frame's.
         motion: camera-motion compensation (module docstring): a panning or yawing
             camera's frame-to-frame shift is measured in :meth:`stream` and :meth:`step`
             (not for precomputed detections given to :meth:`update` alone).
@@ -164,7 +202,7 @@ class VisualTracker:
         order: float = DEFAULT_ORDER,
         memory: int = 30,
         *,
-        sigma_a: float = 0.5,
+        sigma_a: float | tuple[float, float] | None = None,
         sigma_z: float = 2.0,
         sigma_z_rel: float = 0.03,
         sigma_v0: float = 5.0,
@@ -179,6 +217,7 @@ class VisualTracker:
         occlusion: bool = True,
         min_score: float = 0.0,
         horizon: bool = True,
+        stabilise: bool = True,
         motion: bool = True,
         fps: float = 25.0,
         filter_options: dict[str, Any] | None = None,
@@ -194,6 +233,8 @@ class VisualTracker:
         self.min_score = in_range("min_score", min_score, 0.0, 1.0)
         self.fps = positive("fps", fps)
         self.use_horizon = bool(horizon)
+        self.stabilise = bool(stabilise)
+        self._sigma_a = sigma_a  # None: chosen at the first frame (update)
         self._motion = CameraMotion() if motion else None
         opts = dict(filter_options or {})
         if filter == "kf":
@@ -205,7 +246,7 @@ class VisualTracker:
             opts = {"order": self.order, "memory": self.memory, **opts}
         self._mtt_args: dict[str, Any] = dict(
             dt=1.0,
-            sigma_a=sigma_a,
+            sigma_a=STABILISED_SIGMA_A[0] if sigma_a is None else sigma_a,
             sigma_z=sigma_z,
             sigma_v0=sigma_v0,
             gate_probability=gate_probability,
@@ -221,12 +262,16 @@ class VisualTracker:
             sigma_z_rel=sigma_z_rel,
         )
         self._factory = factory
+        self._noise_chosen = False  # the tracker rebuilt with STABILISED_SIGMA_A
         self.mtt = MultiTargetTracker(factory, **self._mtt_args)
         self._smooth = float(size_smoothing)
         self.reset()
 
     def reset(self) -> None:
         """Forget all tracks, the horizon and the frame count (a new video)."""
+        if self._noise_chosen:  # the first frame chooses sigma_a again
+            self.mtt = MultiTargetTracker(self._factory, **self._mtt_args)
+            self._noise_chosen = False
         self.mtt.reset()
         self._offsets: dict[int, FloatArray] = {}
         self._frame = 0
@@ -246,12 +291,16 @@ class VisualTracker:
 
     def restart_tracks(self) -> None:
         """Forget the tracks, not the horizon nor the detector (a frame-size change: the
-        tracks' pixels are another grid's); new tracks continue the ids."""
+        tracks' pixels are another grid's, and so are the stabilised rows' lines); new
+        tracks continue the ids."""
         self.mtt.reset(keep_ids=True)
         self._offsets.clear()
+        self._forget_lines()
 
     def _restart_motion(self) -> None:
         self._shifts: deque[FloatArray] = deque()  # offsets measured, not yet tracked
+        self._lines: deque[Any] = deque()  # horizons queued, not yet tracked
+        self._forget_lines()
         self.camera_offset = np.zeros(2)
         """The accumulated camera shift (x, y) [px] of the last frame tracked
         (:class:`~seawatch.vision.motion.CameraMotion`; 0 for a fixed camera)."""
@@ -266,10 +315,95 @@ class VisualTracker:
             self.camera_offset = self._shifts.popleft()
         return self.camera_offset
 
+    def _forget_lines(self) -> None:
+        """Start the stabilised rows afresh (no line taken)."""
+        self._line: FloatArray | None = None  # the last line taken (x0, y0, x1, y1)
+        self._line_before: FloatArray | None = None  # the line a frame before it
+        self._held = 0  # frames since the last line taken
+        self._given: tuple[FloatArray | None, FloatArray | None] = (None, None)
+        self._steady = 0  # consecutive lines given that followed the two before them
+        self._line_ref: FloatArray | None = None  # the first line taken: the reference
+
+    def next_horizon(self) -> Any:
+        """The horizon queued for the next frame to track (:meth:`stream`, :meth:`step`;
+        so that precomputed detections can be tracked with it later:
+        :meth:`track_detections`), or None when none is waiting."""
+        return self._lines.popleft() if self._lines else None
+
     def _measure_motion(self, image: ArrayLike, horizon: Any) -> None:
-        """Measure the next frame's camera shift (frame order) for :meth:`update`."""
+        """Measure the next frame's camera shift and queue its horizon (frame order) for
+        :meth:`update`."""
         if self._motion is not None:
             self._shifts.append(self._motion.update(image, horizon))
+        if self.stabilise:
+            self._lines.append(horizon)
+
+    def _lift(self, horizon: Any) -> FloatArray | None:
+        """The frame's horizon line ``(x0, y0, x1, y1)`` [px] for stabilised rows: None
+        until :data:`LINE_SETTLE` lines in a row followed the two before them (within
+        :data:`LINE_GATE` of their linear prediction, at the image's ends); from then on
+        the given one where found and within the gate of the last two lines taken (a
+        horizon tracker that jumps onto glare would move every track), else — and where
+        no horizon is found — their linear prediction (at most :data:`LINE_HOLD` frames
+        ahead); a line that stays outside the gate for :data:`LINE_HOLD` frames is taken
+        (the camera did move)."""
+        line = None
+        if horizon is not None and getattr(horizon, "found", True):
+            line = as_float_array(
+                "horizon",
+                [horizon.x0, horizon.y0, horizon.x1, horizon.y1]
+                if hasattr(horizon, "x0")
+                else horizon,
+            ).reshape(4)
+            if not np.all(np.isfinite(line)) or line[2] == line[0]:
+                line = None
+        if self._line is None:  # not yet settled: lines that follow each other
+            if line is None:
+                return None
+            g1, g0 = self._given
+            ok = g1 is not None and self._jump(line, g1, g0) <= LINE_GATE
+            self._steady = self._steady + 1 if ok else 0
+            self._given = (line, g1)
+            if self._steady < LINE_SETTLE:
+                return None
+            self._line, self._line_before, self._line_ref = line, g1, line
+            return line
+        last, before = self._line, self._line_before
+        ahead = self._held + 1  # frames since the last line taken
+        if line is not None and (
+            self._held >= LINE_HOLD or self._jump(line, last, before, ahead) <= LINE_GATE
+        ):
+            # the line a frame before this one, on the way from the last one taken
+            back = None if self._held >= LINE_HOLD else line - (line - last) / ahead
+            self._line, self._line_before, self._held = line, back, 0
+            return line
+        self._held += 1
+        return last if before is None else last + min(ahead, LINE_HOLD) * (last - before)
+
+    def _jump(
+        self, line: FloatArray, last: FloatArray, before: FloatArray | None, ahead: int = 1
+    ) -> float:
+        """How far [px] a line's rows at the ends of ``last`` lie from the linear
+        prediction of ``before`` and ``last``, ``ahead`` frames after ``last`` (``last``
+        itself without ``before``)."""
+        ends = last[[0, 2]]
+        pred = self._rows_at(last, ends)
+        if before is not None:
+            pred = pred + ahead * (pred - self._rows_at(before, ends))
+        return float(np.max(np.abs(self._rows_at(line, ends) - pred)))
+
+    @staticmethod
+    def _rows_at(line: FloatArray, u: FloatArray) -> FloatArray:
+        """A line's rows [px] at columns ``u``."""
+        x0, y0, x1, y1 = line
+        return y0 + (y1 - y0) / (x1 - x0) * (u - x0)
+
+    def _rise(self, line: FloatArray | None, u: FloatArray) -> FloatArray:
+        """How far [px] the horizon's rows at columns ``u`` lie below those of the first
+        line taken, the reference (0 without a line)."""
+        if line is None or self._line_ref is None:
+            return np.zeros_like(u)
+        return self._rows_at(line, u) - self._rows_at(self._line_ref, u)
 
     # ------------------------------------------------------------------ per frame
     def horizon(self, image: ArrayLike, time: float | None = None) -> Any:
@@ -297,7 +431,11 @@ class VisualTracker:
         return _detection_rows(det)
 
     def update(
-        self, detections: Detections | ArrayLike | None, *, offset: ArrayLike | None = None
+        self,
+        detections: Detections | ArrayLike | None,
+        *,
+        offset: ArrayLike | None = None,
+        horizon: Any = _QUEUED,
     ) -> FloatArray:
         """Track one frame's detections (steps 2–3); returns the confirmed tracks.
 
@@ -306,6 +444,11 @@ class VisualTracker:
                 with a score or (k, 7) with the water-line point; None: no detection.
             offset: the frame's accumulated camera shift (x, y) [px]; default: the one
                 :meth:`stream` or :meth:`step` measured for this frame, else the last.
+            horizon: the frame's horizon for the stabilised rows (a
+                :class:`~seawatch.vision.horizon.HorizonEstimate`, a line
+                ``(x0, y0, x1, y1)`` [px] or None); default: the one :meth:`stream` or
+                :meth:`step` queued for this frame. Not found or None: the last lines'
+                prediction (module docstring).
 
         Returns:
             (n, 8) float array of :data:`TRACK_COLUMNS`, rows in order of track id.
@@ -316,6 +459,16 @@ class VisualTracker:
             off = self.next_offset()
         else:
             off = self.camera_offset = as_float_array("offset", offset).reshape(2)
+        hz = self.next_horizon() if horizon is _QUEUED else horizon
+        if self._frame == 0 and self._sigma_a is None and self.stabilise and hz is not None:
+            # horizons come with the frames: the vertical noise of stabilised rows
+            args = {**self._mtt_args, "sigma_a": STABILISED_SIGMA_A}
+            self.mtt = MultiTargetTracker(self._factory, **args)
+            self._noise_chosen = True
+        line = self._lift(hz) if self.stabilise else None
+        # into stabilised rows (at each box's centre column and water-line point)
+        rows[:, 1] -= self._rise(line, rows[:, 0] + 0.5 * rows[:, 2])
+        rows[:, 6] -= self._rise(line, rows[:, 5])
         rows[:, 0:2] -= off  # into the first frame's coordinates
         rows[:, 5:7] -= off
         states = self.mtt.step(rows[:, :4] if rows.shape[0] else None, float(self._frame))
@@ -323,6 +476,8 @@ class VisualTracker:
         out = self._rows(states, rows)
         out[:, 1:3] += off  # back into this frame's pixels
         out[:, 5:7] += off
+        out[:, 2] += self._rise(line, out[:, 1] + 0.5 * out[:, 3])
+        out[:, 6] += self._rise(line, out[:, 5])
         return out
 
     def coast(self, frames: int) -> None:
@@ -437,21 +592,28 @@ class VisualTracker:
         return out
 
     def track_detections(
-        self, detections: Sequence[Any], offsets: Sequence[ArrayLike] | None = None
+        self,
+        detections: Sequence[Any],
+        offsets: Sequence[ArrayLike] | None = None,
+        horizons: Sequence[Any] | None = None,
     ) -> list[FloatArray]:
         """Per-frame confirmed tracks of precomputed per-frame detections (no detector).
 
         Lets several filters run on the very same detections (the ship-video scenario);
         ``offsets``: the frames' camera offsets (:meth:`next_offset` while they were
-        detected); None: a fixed camera.
+        detected); None: a fixed camera. ``horizons``: the frames' horizons for the
+        stabilised rows (:meth:`next_horizon` while they were detected); None: none.
         """
-        if offsets is None:
-            return [self.update(d, offset=(0.0, 0.0)) for d in detections]
-        if len(offsets) != len(detections):
-            raise ValueError(
-                f"offsets: expected one per frame ({len(detections)}), got {len(offsets)}"
-            )
-        return [self.update(d, offset=o) for d, o in zip(detections, offsets, strict=True)]
+        n = len(detections)
+        for name, seq in (("offsets", offsets), ("horizons", horizons)):
+            if seq is not None and len(seq) != n:
+                raise ValueError(f"{name}: expected one per frame ({n}), got {len(seq)}")
+        offs = [(0.0, 0.0)] * n if offsets is None else offsets
+        lines = [None] * n if horizons is None else horizons
+        return [
+            self.update(d, offset=o, horizon=h)
+            for d, o, h in zip(detections, offs, lines, strict=True)
+        ]
 
     # ------------------------------------------------------------------ output
     def _rows(self, st: TrackStates, det: FloatArray) -> FloatArray:
