@@ -76,6 +76,19 @@ def _tracker(**kw):
     return MultiTargetTracker(**opts)
 
 
+def _visual_tracker():
+    """A tracker with VisualTracker's settings for frames without horizons."""
+    return _tracker(
+        confirm_m=3,
+        confirm_n=5,
+        occlusion=True,
+        overlap_gate=0.5,
+        sigma_a=0.5,
+        sigma_z=2.0,
+        sigma_z_rel=0.03,
+    )
+
+
 # ------------------------------------------------------------------ assignment
 
 
@@ -776,16 +789,8 @@ def test_occlusion_a_box_around_a_ship_with_its_own_box_is_the_track_s(behind):
     two: A is measured by its box, its id kept, and within 0.3 px of A's centre ten
     frames on. Where B is behind A (water line above A's) the box's left end may be
     B's, and A keeps its remembered width. The tracker's settings are VisualTracker's
-    defaults."""
-    trk = _tracker(
-        confirm_m=3,
-        confirm_n=5,
-        occlusion=True,
-        overlap_gate=0.5,
-        sigma_a=0.5,
-        sigma_z=2.0,
-        sigma_z_rel=0.03,
-    )
+    without horizons."""
+    trk = _visual_tracker()
     b_top = 197.0 if behind else 203.0
     for k in range(25):
         a_left, b_left = 100.0 + 0.5 * k, 100.0 + 0.7 * k
@@ -872,15 +877,7 @@ def test_occlusion_a_settled_ship_keeps_its_width_behind_a_boat_at_its_end():
     A is measured by its free right end and its width (meeting case, seed 1, frame 130:
     the ferry's track took the 46-px box of both and kept a width of 41.5 px for its 39.6
     px, 2 px off, for 50 frames)."""
-    trk = _tracker(
-        confirm_m=3,
-        confirm_n=5,
-        occlusion=True,
-        overlap_gate=0.5,
-        sigma_a=0.5,
-        sigma_z=2.0,
-        sigma_z_rel=0.03,
-    )
+    trk = _visual_tracker()
     for k in range(60):
         a_left = 100.0 + 0.2 * k
         boxes = [[a_left, 200.0, 40.0, 9.0]]
