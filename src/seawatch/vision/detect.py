@@ -1293,7 +1293,8 @@ class ClassicalShipDetector:
         if not cands or self.clutter_rate == 0:
             return cands
         grow = (lv0.z > self.grow_threshold).view(np.uint8)
-        passed = [self._clutter_pass(c, cv2.integral(grow), grow.shape) for c in cands]
+        ii = cv2.integral(grow)
+        passed = [self._clutter_pass(c, ii, grow.shape) for c in cands]
         for pol in (1, 2):
             clear = [c for i, c in enumerate(cands) if passed[i] and c.polarity & pol]
             failed = [
@@ -1315,9 +1316,9 @@ class ClassicalShipDetector:
             for c in clear:
                 x0, y0, x1, y1 = (int(v) for v in c.box)
                 masked[max(0, y0) : y1 + 1, max(0, x0) : x1 + 1] = 0
-            ii = cv2.integral(masked)
+            ii_clear = cv2.integral(masked)
             for i in failed:
-                passed[i] = self._clutter_pass(cands[i], ii, grow.shape)
+                passed[i] = self._clutter_pass(cands[i], ii_clear, grow.shape)
         return [c for c, ok in zip(cands, passed, strict=True) if ok]
 
     def _clutter_pass(self, c: _Candidate, ii: NDArray, shape: tuple[int, int]) -> bool:
