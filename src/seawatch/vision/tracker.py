@@ -29,7 +29,8 @@ horizons, 0.5 for both axes when they do not). The line is the frame's horizon
 :meth:`VisualTracker.step`, or given to :meth:`VisualTracker.update`), taken once it has
 settled (:data:`LINE_SETTLE`) and where it follows the lines before it
 (:data:`LINE_GATE`); a frame whose horizon jumps or is not found takes their linear
-prediction. Until the first line is taken the rows are the frame's.
+prediction. Until the first line is taken the rows are the frame's. (The project's own
+addition [NEW]: the seed tracks the box centre in the frame's pixels, §1.3.)
 
 With ``motion`` (default) a moving camera's image shift is taken out first
 (:class:`~seawatch.vision.motion.CameraMotion`, measured on each frame where its horizon
