@@ -138,6 +138,25 @@ def _detection_rows(det: Detections | ArrayLike | None) -> FloatArray:
     return out
 
 
+def _line_rows(line: FloatArray, u: FloatArray) -> FloatArray:
+    """A line's ``(x0, y0, x1, y1)`` [px] rows [px] at columns ``u``."""
+    x0, y0, x1, y1 = line
+    return y0 + (y1 - y0) / (x1 - x0) * (u - x0)
+
+
+def _line_jump(
+    line: FloatArray, last: FloatArray, before: FloatArray | None, ahead: int = 1
+) -> float:
+    """How far [px] a line's rows at the ends of ``last`` lie from the linear prediction
+    of ``before`` and ``last``, ``ahead`` frames after ``last`` (``last`` itself without
+    ``before``) (:meth:`VisualTracker._lift`)."""
+    ends = last[[0, 2]]
+    pred = _line_rows(last, ends)
+    if before is not None:
+        pred = pred + ahead * (pred - _line_rows(before, ends))
+    return float(np.max(np.abs(_line_rows(line, ends) - pred)))
+
+
 class VisualTracker:
     """Ship boxes per frame → confirmed pixel tracks (module docstring, steps 1–3).
 
@@ -263,16 +282,15 @@ class VisualTracker:
             sigma_z_rel=sigma_z_rel,
         )
         self._factory = factory
-        self._noise_chosen = False  # the tracker rebuilt with STABILISED_SIGMA_A
         self.mtt = MultiTargetTracker(factory, **self._mtt_args)
         self._smooth = float(size_smoothing)
         self.reset()
 
     def reset(self) -> None:
         """Forget all tracks, the horizon and the frame count (a new video)."""
-        if self._noise_chosen:  # the first frame chooses sigma_a again
+        if self._sigma_a is None and np.ndim(self.mtt.sigma_a):
+            # the first frame rebuilt the tracker with STABILISED_SIGMA_A: it chooses again
             self.mtt = MultiTargetTracker(self._factory, **self._mtt_args)
-            self._noise_chosen = False
         self.mtt.reset()
         self._offsets: dict[int, FloatArray] = {}
         self._frame = 0
@@ -331,7 +349,7 @@ class VisualTracker:
         :meth:`track_detections`), or None when none is waiting."""
         return self._lines.popleft() if self._lines else None
 
-    def _measure_motion(self, image: ArrayLike, horizon: Any) -> None:
+    def _queue_frame(self, image: ArrayLike, horizon: Any) -> None:
         """Measure the next frame's camera shift and queue its horizon (frame order) for
         :meth:`update`."""
         if self._motion is not None:
@@ -362,7 +380,7 @@ class VisualTracker:
             if line is None:
                 return None
             g1, g0 = self._given
-            ok = g1 is not None and self._jump(line, g1, g0) <= LINE_GATE
+            ok = g1 is not None and _line_jump(line, g1, g0) <= LINE_GATE
             self._steady = self._steady + 1 if ok else 0
             self._given = (line, g1)
             if self._steady < LINE_SETTLE:
@@ -372,7 +390,7 @@ class VisualTracker:
         last, before = self._line, self._line_before
         ahead = self._held + 1  # frames since the last line taken
         if line is not None and (
-            self._held >= LINE_HOLD or self._jump(line, last, before, ahead) <= LINE_GATE
+            self._held >= LINE_HOLD or _line_jump(line, last, before, ahead) <= LINE_GATE
         ):
             # the line a frame before this one, on the way from the last one taken
             back = None if self._held >= LINE_HOLD else line - (line - last) / ahead
@@ -381,30 +399,12 @@ class VisualTracker:
         self._held += 1
         return last if before is None else last + min(ahead, LINE_HOLD) * (last - before)
 
-    def _jump(
-        self, line: FloatArray, last: FloatArray, before: FloatArray | None, ahead: int = 1
-    ) -> float:
-        """How far [px] a line's rows at the ends of ``last`` lie from the linear
-        prediction of ``before`` and ``last``, ``ahead`` frames after ``last`` (``last``
-        itself without ``before``)."""
-        ends = last[[0, 2]]
-        pred = self._rows_at(last, ends)
-        if before is not None:
-            pred = pred + ahead * (pred - self._rows_at(before, ends))
-        return float(np.max(np.abs(self._rows_at(line, ends) - pred)))
-
-    @staticmethod
-    def _rows_at(line: FloatArray, u: FloatArray) -> FloatArray:
-        """A line's rows [px] at columns ``u``."""
-        x0, y0, x1, y1 = line
-        return y0 + (y1 - y0) / (x1 - x0) * (u - x0)
-
     def _rise(self, line: FloatArray | None, u: FloatArray) -> FloatArray:
         """How far [px] the horizon's rows at columns ``u`` lie below those of the first
         line taken, the reference (0 without a line)."""
         if line is None or self._line_ref is None:
             return np.zeros_like(u)
-        return self._rows_at(line, u) - self._rows_at(self._line_ref, u)
+        return _line_rows(line, u) - _line_rows(self._line_ref, u)
 
     # ------------------------------------------------------------------ per frame
     def horizon(self, image: ArrayLike, time: float | None = None) -> Any:
@@ -465,7 +465,6 @@ class VisualTracker:
             # horizons come with the frames: the vertical noise of stabilised rows
             args = {**self._mtt_args, "sigma_a": STABILISED_SIGMA_A}
             self.mtt = MultiTargetTracker(self._factory, **args)
-            self._noise_chosen = True
         line = self._lift(hz) if self.stabilise else None
         # into stabilised rows (at each box's centre column and water-line point)
         rows[:, 1] -= self._rise(line, rows[:, 0] + 0.5 * rows[:, 2])
@@ -503,7 +502,7 @@ class VisualTracker:
     def step(self, image: ArrayLike, time: float | None = None) -> FloatArray:
         """Detect and track one frame; the confirmed tracks (:meth:`update`)."""
         detections = self.detect(image, time)
-        self._measure_motion(image, self.last_horizon)
+        self._queue_frame(image, self.last_horizon)
         return self.update(detections)
 
     def stream(
@@ -538,7 +537,7 @@ class VisualTracker:
         def horizon(fr: Any) -> tuple[Any, Any, Any]:
             image = getattr(fr, "image", fr)
             hz = self.horizon(image, getattr(fr, "time", None))
-            self._measure_motion(image, hz)
+            self._queue_frame(image, hz)
             # a detector that can prepare a frame apart (the classical one: its working
             # band) does so here, which balances the two threads
             return fr, hz, prepare(image, horizon=hz) if split else None  # type: ignore[misc]
