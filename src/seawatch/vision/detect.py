@@ -604,8 +604,7 @@ def _frac_inside(inner: NDArray, outer: NDArray) -> float:
     ih = min(inner[3], outer[3]) - max(inner[1], outer[1]) + 1
     if iw <= 0 or ih <= 0:
         return 0.0
-    area = (inner[2] - inner[0] + 1) * (inner[3] - inner[1] + 1)
-    return float(iw * ih / area)
+    return float(iw * ih / _area(inner))
 
 
 def _overlap(a: NDArray, b: NDArray) -> bool:
