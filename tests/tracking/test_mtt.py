@@ -181,6 +181,32 @@ def test_size_relative_noise_is_a_kalman_filter_with_that_r(factory):
         np.testing.assert_allclose(out.covariances[0], ref.covariances[-1], atol=1e-9)
 
 
+@pytest.mark.parametrize("factory", [None, KalmanFilter])
+def test_stale_detections_are_predictions_of_the_kalman_filter(factory):
+    """Every third detection flagged stale: the track is the Kalman filter updated with
+    the others and predicting through the stale ones (z = None), on the batched path
+    and with per-track filter objects; the track counts them as hits (no misses), and
+    its box keeps the size the fresh ones gave. A flag per detection or an error."""
+    rng = np.random.default_rng(11)
+    zs = np.column_stack([10 + 2.0 * np.arange(30), 50 - 1.0 * np.arange(30)])
+    zs = zs + rng.normal(0.0, 1.0, size=zs.shape)
+    trk = _tracker(filter_factory=factory)
+    kf = KalmanFilter(trk.F, trk.H, trk.Q, trk.R, np.r_[zs[0], 0.0, 0.0], trk.P0)
+    for k, z in enumerate(zs):
+        stale = k > 0 and k % 3 == 0
+        w = 5.0 if stale else 8.0
+        out = trk.step(np.array([[z[0] - w / 2, z[1] - 2.0, w, 4.0]]), stale=[stale])
+        if k:
+            kf.predict()
+            kf.update(None if stale else z)
+    np.testing.assert_allclose(out.states[0], kf.x, atol=1e-9)
+    np.testing.assert_allclose(out.covariances[0], kf.P, atol=1e-9)
+    assert out.misses[0] == 0 and out.hits[0] == 30
+    np.testing.assert_allclose(out.boxes[0, 2:], [8.0, 4.0])
+    with pytest.raises(ValueError, match="stale"):
+        trk.step(np.zeros((2, 4)) + 1.0, stale=[True])
+
+
 def test_irregular_scan_times_use_the_actual_interval():
     times = np.cumsum(np.r_[0.0, np.random.default_rng(1234).uniform(0.5, 2.0, 40)])
     truth = np.column_stack([3.0 * times, 100 + 0.5 * times])

@@ -80,6 +80,38 @@ def test_coast_over_lost_frames_keeps_the_track(name):
         VisualTracker(horizon=False).coast(-1)
 
 
+@pytest.mark.parametrize("name", ["afkf", "kf"])
+def test_a_repeated_box_is_no_new_measurement(name):
+    """A boat (10 × 4 px) moving 0.5 px a frame whose detection freezes for three frames
+    (a codec's skipped block: the same box to the last bit) and then jumps to where the
+    boat is. The frozen boxes are no measurements: the track goes on at the boat's speed
+    through them (to 0.05 px); taken as measurements they pull it back (over 0.5 px
+    behind the boat at the third). A box that stays the same for longer than
+    ``STALE_LIMIT`` frames is a still scene, measured again: the track of a boat that
+    stops coasts on through the first ``STALE_LIMIT`` repeats, then settles on it."""
+    from seawatch.vision.tracker import STALE_LIMIT
+
+    def box(x):
+        return np.array([[x, 200.0, 10.0, 4.0]])
+
+    vt = VisualTracker(detector=lambda *a, **k: None, filter=name, horizon=False)
+    for k in range(40):
+        vt.update(box(100.0 + 0.5 * k))
+    frozen = [vt.update(box(100.0 + 0.5 * 39))[0] for _ in range(3)]
+    truth = 100.0 + 0.5 * np.arange(40, 43)
+    assert np.abs(np.array([t[1] for t in frozen]) - truth).max() < 0.05
+    assert all(t[7] == 0 for t in frozen)  # a hit, not a miss
+    ref = VisualTracker(detector=lambda *a, **k: None, filter=name, horizon=False)
+    for k in range(40):  # the tracker without the flags: every box measured
+        ref.mtt.step(box(100.0 + 0.5 * k)[:, :4])
+    for _ in range(3):
+        st = ref.mtt.step(box(100.0 + 0.5 * 39)[:, :4])
+    assert truth[-1] - st.boxes[0, 0] > 0.5
+    # the boat stops where it is: the same box for 4 × STALE_LIMIT frames
+    out = [vt.update(box(truth[-1]))[0] for _ in range(4 * STALE_LIMIT)]
+    assert abs(out[-1][1] - truth[-1]) < 0.1
+
+
 def test_track_frames_coasts_over_frames_whose_index_skips():
     """``track_frames`` on ``Frame`` objects whose indices skip 30-34 (lost from the
     source): the same boat as above keeps one id, one output per frame given, and

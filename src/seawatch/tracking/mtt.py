@@ -499,7 +499,13 @@ class MultiTargetTracker:
         return t
 
     # ------------------------------------------------------------------ one scan
-    def step(self, detections: ArrayLike | None, time: float | None = None) -> TrackStates:
+    def step(
+        self,
+        detections: ArrayLike | None,
+        time: float | None = None,
+        *,
+        stale: ArrayLike | None = None,
+    ) -> TrackStates:
         """Process one scan of detections and return the live tracks.
 
         Args:
@@ -511,11 +517,24 @@ class MultiTargetTracker:
                 first scan, then the previous time plus ``dt``. The prediction uses the
                 actual interval (the default filter and the KalmanFilter class; other
                 per-track filters need the nominal ``dt``).
+            stale: (k,) flags of detections that repeat an earlier one and carry no new
+                measurement (a video codec's skipped block, a duplicated frame): they
+                are associated (and start tracks) as usual, and a track that takes one
+                counts a hit, but its filter only predicts and its size is kept. None:
+                every detection is new.
 
         Returns:
             :class:`TrackStates` of every live track after this scan.
         """
         centres, sizes = self._detections(detections)
+        repeat = np.zeros(centres.shape[0], bool)
+        if stale is not None:
+            repeat = np.asarray(stale, dtype=bool).reshape(-1)
+            if repeat.shape[0] != centres.shape[0]:
+                raise ValueError(
+                    f"stale: expected one flag per detection ({centres.shape[0]}), "
+                    f"got {repeat.shape[0]}"
+                )
         t = self._step_time(time)
         dt = self.dt if self._time is None else t - self._time
         valid = np.flatnonzero(np.all(np.isfinite(centres), axis=1))
@@ -553,14 +572,15 @@ class MultiTargetTracker:
         assigned = np.zeros(self.n_tracks, bool)
         assigned[rows] = True
         self._S = None  # the update changes P
-        self._update(rows, zu)
+        new = ~repeat[valid[cols]]  # a repeated detection: no update, no size
+        self._update(rows[new], zu[new])
         detection = np.full(self.n_tracks, -1, np.int64)
         detection[rows] = valid[cols]
         restarted = np.zeros(self.n_tracks, bool)
         if sizes is not None and rows.size:
             s = self.size_smoothing
             change = s * (sizes[valid[cols]] - self._size[rows])
-            self._size[rows] += np.where(grow, change, 0.0)
+            self._size[rows] += np.where(grow & new[:, None], change, 0.0)
         if boxes:
             if r2.size:
                 restarted[r2] = True

@@ -14,7 +14,9 @@ Issue 6, "Visual tracking"; ALGORITHMS.md §1.3–1.5. Per frame:
    * ``"fkf"``: :class:`~seawatch.filters.FractionalKalmanFilter` (§1.4, constant Q),
    * ``"kf"``: the integer-order Kalman filter (the CV model; §1.3: the FKF at order 1);
 
-   the box size is smoothed exponentially alongside;
+   the box size is smoothed exponentially alongside; a box that repeats one of the
+   frame before to the last bit (a codec's skipped block, a duplicated frame:
+   :data:`STALE_LIMIT`) is associated but measures nothing — its track predicts;
 3. confirmed tracks are reported, also while they coast on their prediction through a
    short occlusion or missed detections (up to ``delete_after`` frames).
 
@@ -53,7 +55,7 @@ from collections.abc import Iterable, Iterator, Sequence
 from typing import Any, Literal
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from seawatch._validation import FloatArray, as_float_array, in_range, integer, positive
 from seawatch.filters import (
@@ -69,6 +71,7 @@ __all__ = [
     "DEFAULT_ORDER",
     "FILTERS",
     "STABILISED_SIGMA_A",
+    "STALE_LIMIT",
     "TRACK_COLUMNS",
     "VisualTracker",
     "frames_lost",
@@ -100,6 +103,13 @@ LINE_SETTLE = 3
 rows are stabilised at all (a horizon tracker still converging — the rendered lighting
 case's second rendering: 20 px off at one end in its first frames — would move every
 track)."""
+
+STALE_LIMIT = 10
+"""Consecutive frames a detection that repeats the one before it to the last bit is taken
+as no new measurement (:class:`VisualTracker`): a video codec's skipped block shows the
+ship where it was when the block was last coded (the rendered small case: runs of 1–6
+frames), a capture that duplicates frames shows it twice. A box that stays the same for
+longer is a still scene: measured again."""
 
 STABILISED_SIGMA_A: tuple[float, float] = (0.5, 0.1)
 """Default acceleration noise (horizontal, vertical) [px/frame²] of a box centre in
@@ -292,6 +302,7 @@ class VisualTracker:
             # the first frame rebuilt the tracker with STABILISED_SIGMA_A: it chooses again
             self.mtt = MultiTargetTracker(self._factory, **self._mtt_args)
         self.mtt.reset()
+        self._forget_repeats()
         self._offsets: dict[int, FloatArray] = {}
         self._frame = 0
         self._last_index: int | None = None  # source index of the last frame (coast_to)
@@ -313,6 +324,7 @@ class VisualTracker:
         tracks' pixels are another grid's, and so are the stabilised rows' lines); new
         tracks continue the ids."""
         self.mtt.reset(keep_ids=True)
+        self._forget_repeats()
         self._offsets.clear()
         self._forget_lines()
 
@@ -325,6 +337,22 @@ class VisualTracker:
         (:class:`~seawatch.vision.motion.CameraMotion`; 0 for a fixed camera)."""
         if self._motion is not None:
             self._motion.reset()
+
+    def _forget_repeats(self) -> None:
+        self._last_boxes = np.empty((0, 4))  # the last frame's boxes, as detected
+        self._repeats = np.empty(0, np.int64)  # frames each of them repeated the one before
+
+    def _stale(self, boxes: FloatArray) -> NDArray[np.bool_]:
+        """Flags of the boxes (k, 4) that repeat one of the last frame's to the last bit,
+        for at most :data:`STALE_LIMIT` frames in a row (no new measurement)."""
+        last = self._last_boxes
+        count = np.zeros(boxes.shape[0], np.int64)
+        if boxes.shape[0] and last.shape[0]:
+            same = np.all(boxes[:, None, :] == last[None, :, :], axis=2)
+            hit = same.any(axis=1)
+            count[hit] = self._repeats[same.argmax(axis=1)[hit]] + 1
+        self._last_boxes, self._repeats = boxes.copy(), count
+        return (count >= 1) & (count <= STALE_LIMIT)
 
     def next_offset(self) -> FloatArray:
         """The camera offset (x, y) [px] measured for the next frame to track, taken from
@@ -456,6 +484,7 @@ class VisualTracker:
         """
         rows = _detection_rows(detections)
         rows = rows[rows[:, 4] >= self.min_score]
+        stale = self._stale(rows[:, :4])  # in the frame's own pixels, as detected
         if offset is None:
             off = self.next_offset()
         else:
@@ -471,7 +500,8 @@ class VisualTracker:
         rows[:, 6] -= self._rise(line, rows[:, 5])
         rows[:, 0:2] -= off  # into the first frame's coordinates
         rows[:, 5:7] -= off
-        states = self.mtt.step(rows[:, :4] if rows.shape[0] else None, float(self._frame))
+        boxes = rows[:, :4] if rows.shape[0] else None
+        states = self.mtt.step(boxes, float(self._frame), stale=stale if rows.shape[0] else None)
         self._frame += 1
         out = self._rows(states, rows)
         out[:, 1:3] += off  # back into this frame's pixels
@@ -486,6 +516,7 @@ class VisualTracker:
         filters, whose model steps one frame at a time, keep their velocities per frame
         and the missed frames count towards deletion (none once no track is left)."""
         for _ in range(integer("frames", frames, 0)):
+            self._forget_repeats()  # a frame lost between: no longer the one before
             if self.mtt.n_tracks == 0:
                 break
             self.mtt.step(None, float(self._frame))
