@@ -82,8 +82,8 @@ def test_coast_over_lost_frames_keeps_the_track(name):
 
 @pytest.mark.parametrize("name", ["afkf", "kf"])
 def test_a_repeated_box_is_no_new_measurement(name):
-    """A boat (10 × 4 px) moving 0.5 px a frame whose detection freezes for three frames
-    (a codec's skipped block: the same box to the last bit) and then jumps to where the
+    """A boat (10 × 4 px) moving 0.5 px a frame whose box stays put for three frames (the
+    same box exactly: whole-pixel edges that did not move) and then jumps to where the
     boat is. The frozen boxes are no measurements: the track goes on at the boat's speed
     through them (to 0.05 px); taken as measurements they pull it back (over 0.5 px
     behind the boat at the third). A box that stays the same for longer than

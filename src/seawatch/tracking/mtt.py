@@ -517,11 +517,12 @@ class MultiTargetTracker:
                 first scan, then the previous time plus ``dt``. The prediction uses the
                 actual interval (the default filter and the KalmanFilter class; other
                 per-track filters need the nominal ``dt``).
-            stale: (k,) flags of detections that repeat an earlier one and carry no new
-                measurement (a video codec's skipped block, a duplicated frame): they
-                are associated (and start tracks) as usual, and a track that takes one
-                counts a hit, but its filter only predicts and its size is kept. None:
-                every detection is new.
+            stale: (k,) flags of detections that repeat an earlier one exactly and so
+                carry no new measurement (their error is the earlier one's: a box whose
+                whole-pixel edges did not move, a duplicated frame): they are associated
+                (and start tracks) as usual, and a track that takes one counts a hit,
+                but its filter only predicts and its size is kept. None: every
+                detection is new.
 
         Returns:
             :class:`TrackStates` of every live track after this scan.

@@ -15,8 +15,8 @@ Issue 6, "Visual tracking"; ALGORITHMS.md §1.3–1.5. Per frame:
    * ``"kf"``: the integer-order Kalman filter (the CV model; §1.3: the FKF at order 1);
 
    the box size is smoothed exponentially alongside; a box that repeats one of the
-   frame before to the last bit (a codec's skipped block, a duplicated frame:
-   :data:`STALE_LIMIT`) is associated but measures nothing — its track predicts;
+   frame before exactly (:data:`STALE_LIMIT`) is associated but measures nothing — its
+   track predicts;
 3. confirmed tracks are reported, also while they coast on their prediction through a
    short occlusion or missed detections (up to ``delete_after`` frames).
 
@@ -105,11 +105,14 @@ case's second rendering: 20 px off at one end in its first frames — would move
 track)."""
 
 STALE_LIMIT = 10
-"""Consecutive frames a detection that repeats the one before it to the last bit is taken
-as no new measurement (:class:`VisualTracker`): a video codec's skipped block shows the
-ship where it was when the block was last coded (the rendered small case: runs of 1–6
-frames), a capture that duplicates frames shows it twice. A box that stays the same for
-longer is a still scene: measured again."""
+"""Consecutive frames a box (x, y, w, h) that repeats one of the frame before exactly is
+taken as no new measurement (:class:`VisualTracker`): its error is the one before's. A
+distant ship moves a fraction of a pixel per frame and the detector's box edges are
+whole pixels, so its box stays put for a few frames and then jumps (the rendered small
+case, a 10-px boat at 0.2 px/frame: 30 % of its boxes repeat, in runs of 1–6 frames,
+though the pixels under them changed); a capture that duplicates frames repeats every
+box. Measured as new, the repeats hold the track back where the box last jumped to. A
+box that stays the same for longer is a still scene: measured again."""
 
 STABILISED_SIGMA_A: tuple[float, float] = (0.5, 0.1)
 """Default acceleration noise (horizontal, vertical) [px/frame²] of a box centre in
