@@ -602,6 +602,31 @@ def test_water_line_of_a_hull_seen_at_an_angle_lies_on_its_sloping_edge(refine):
     assert abs(v - (t[5] + slope * (u - t[4]))) <= 0.15  # on the edge, not its lowest end
 
 
+@pytest.mark.parametrize("colour", [False, True])
+def test_ship_ends_follow_a_fraction_of_a_pixel(colour):
+    """A 40 px hull (with its superstructure) moved by eighths of a pixel, drawn with
+    exact coverage, lens-blurred (0.8 px), noise 2 grey levels: the box's ends are on
+    the hull's ends to 0.15 px and move with it. Whole-pixel ends (the mask's, before)
+    were 0.5 px off at the half-pixel shifts and stood still between them."""
+    rng = np.random.default_rng(5)
+    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
+    noise = rng.normal(0, 2.0, base.shape)
+    lefts = []
+    for k in range(8):
+        img = base.copy()
+        t = box_ship(img, base, 300.0 + k / 8, 220.4, 40, 6, -45)
+        img = as_u8(cv2.GaussianBlur(img, (0, 0), 0.8) + noise)
+        if colour:
+            img = cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
+        det = ClassicalShipDetector()(img, horizon=hz)
+        found, n_false = match(det, np.array([t]))
+        assert found[0] >= 0 and n_false == 0, det.boxes
+        x, w = det.x[found[0]], det.w[found[0]]
+        assert abs(x - t[0]) < 0.15 and abs(x + w - t[0] - t[2]) < 0.15, (k, x, w, t)
+        lefts.append(x)
+    assert np.all(np.diff(lefts) > 0), lefts
+
+
 def _two_ships(seed: int, first: tuple, second: tuple, **detector):
     """A sea scene with two ships drawn by :func:`box_ship` (``(cx, wl, length, hull,
     contrast, sup)`` each), lens-blurred, noise 2 grey levels; returns the detections,
@@ -1005,7 +1030,7 @@ def test_masked_detector_keeps_the_boxes_whose_water_line_is_in_the_region(tmp_p
     region[:, 320:] = 255
     masked = MaskedDetector(inner, region)
     full = inner(img, horizon=hz)
-    right = full.boxes[full.u_wl >= 320]
+    right = full.boxes[np.round(full.u_wl) >= 320]  # the pixel of the water-line point
     assert 0 < len(right) < len(full)
     np.testing.assert_array_equal(masked(img, horizon=hz).boxes, right)
     prepared = masked.prepare(img, horizon=hz)

@@ -1571,6 +1571,10 @@ class ClassicalShipDetector:
                 uu, vv = _waterline(ship)
                 u, v = x + uu, y + vv
             w, h = float(sc1 - sc0 + 1), float(sr1 - sr0 + 1)
+            ends = _subpixel_ends(fr, ship, X0 + sc0, Y0 + sr0)
+            if ends is not None:  # the ends to a fraction of a pixel; u moves with them
+                u += 0.5 * (ends[0] + ends[1]) - (x + 0.5 * w)
+                x, w = ends[0], ends[1] - ends[0]
             if low is not None and low > y:
                 # a ship's lowest point is on its water line: the box ends there, to a
                 # fraction of a pixel (the smoothing's spill below a strong hull can
@@ -2006,6 +2010,75 @@ def _distinct(
     return np.array(sorted(keep), dtype=np.intp)
 
 
+def _subpixel_ends(
+    fr: _Frame, ship: NDArray[np.bool_], fx0: int, fy0: int
+) -> tuple[float, float] | None:
+    """The left and right ends [frame px, pixel centres at integers] of a ship whose mask
+    ``ship`` (its box's rows and columns) has its top-left pixel at frame pixel ``(fx0,
+    fy0)``, to a fraction of a pixel; None where neither can be measured (an end that
+    cannot keeps the mask's).
+
+    The mask's ends are whole pixels (a pixel at least half covered is the ship's), so a
+    distant ship's box stays put for frames while the ship moves a fraction of a pixel
+    and then jumps by one. At each end, over the rows whose mask reaches that end's
+    column (the ship's farthest point there: a bow's tip, not its taper): the
+    background is the per-row median of :data:`_END_FLANK` columns beyond the coverage
+    window (what lies beside that end: the sea, or the ship behind); each pixel's
+    difference from it — luma, or (Y, Cr, Cb) projected on the ship's mean difference,
+    so that noise averages out instead of adding up — averaged over the rows and
+    divided by its median over the inner columns is the column's covered fraction
+    ``f``. The ends are the coverage integrals ``x_l = c_0 + 1.5 − Σ_{c_0−2 … c_0+1} f``
+    and ``x_r = c_1 − 1.5 + Σ_{c_1−1 … c_1+2} f`` (``c_0, c_1`` the mask's end columns):
+    for an area-sampled end exactly its position, and a symmetric blur (the lens, the
+    codec) moves the contrast across it without changing the integral — as the water
+    line's (:func:`seawatch.vision.waterline._edge_waterline`). An end keeps the mask's
+    where the frame's edge is too near, the integral's noise (four columns of the
+    background's spread over the rows) would exceed :data:`_END_SIGMA` px, the
+    background beside it is not flat (a column of it, or the window's outer one, a
+    quarter of the level from it: another object, glint), or the integral lies more
+    than a pixel from the mask's end. The project's own addition [NEW]."""
+    nr, nc = ship.shape
+    W = fr.shape[1]
+    if nc < 3:
+        return None
+    lo = max(0, fx0 - 2 - _END_FLANK)  # the frame's columns lo … hi − 1 are read
+    hi = min(W, fx0 + nc + 2 + _END_FLANK)
+    if fr.colour is not None:
+        crop = np.ascontiguousarray(fr.colour[fy0 : fy0 + nr, lo:hi])
+        img = cv2.cvtColor(crop, cv2.COLOR_BGR2YCrCb).astype(np.float32)
+    else:
+        img = fr.grey_crop(fy0, fy0 + nr, lo, hi)[:, :, None]
+    ends = [fx0 - 0.5, fx0 + nc - 0.5]  # the mask's
+    measured = False
+    x0 = fx0 - lo  # the mask's first column in the crop
+    for side, (a, b) in enumerate(((x0 - 2, x0 + 2), (x0 + nc - 2, x0 + nc + 2))):
+        fa, fb = (a - _END_FLANK, a) if side == 0 else (b, b + _END_FLANK)
+        if fa < 0 or fb > hi - lo:
+            continue
+        im = img[ship[:, 0 if side == 0 else -1]]  # the rows that reach this end
+        bg = np.median(im[:, fa:fb], axis=1)[:, None, :]  # (rows, 1, channels)
+        inner = im[:, x0 + 1 : x0 + nc - 1] - bg
+        mean = inner.reshape(-1, img.shape[2]).mean(axis=0)
+        norm = float(np.linalg.norm(mean))
+        if norm == 0.0:
+            continue
+        unit = mean / norm
+        level = float(np.median((inner @ unit).mean(axis=0)))
+        flank = (im[:, fa:fb] - bg) @ unit
+        # the integral's noise, four columns' worth, below a whole-pixel end's (0.29 px)
+        if level <= 0.0 or 2.0 * _mad(flank) / math.sqrt(im.shape[0]) > _END_SIGMA * level:
+            continue
+        f = ((im[:, a:b] - bg) @ unit).mean(axis=0) / level
+        outer = f[0] if side == 0 else f[-1]
+        if abs(outer) >= 0.25 or np.abs(flank.mean(axis=0)).max() >= 0.25 * level:
+            continue  # no flat background beside it
+        end = float(f.sum())  # unclipped: noise and a ringing edge's lobes average out
+        end = lo + (a + 3.5 - end if side == 0 else a - 0.5 + end)
+        if abs(end - ends[side]) <= 1.0:
+            ends[side], measured = end, True
+    return (ends[0], ends[1]) if measured else None
+
+
 def _mask_extent(mask: NDArray[np.bool_]) -> tuple[int, int, int, int]:
     """Inclusive extent ``(r0, r1, c0, c1)`` of a non-empty mask."""
     rr = np.flatnonzero(mask.any(axis=1))
@@ -2044,4 +2117,6 @@ def _touching_groups(parts: list[NDArray[np.bool_]]) -> list[list[NDArray[np.boo
 
 
 _FLANK_SAMPLES = 32
+_END_FLANK = 4  # columns of background beside each end of a ship (_subpixel_ends)
+_END_SIGMA = 0.25  # largest noise [px] of a sub-pixel end measured (_subpixel_ends)
 """Columns per flank (at most about) whose medians give a window's background."""
