@@ -789,7 +789,9 @@ class ClassicalShipDetector:
        (superstructure, masts) joined, background structure reaching the window's edge
        (a glint path) dropped; it costs a few ms per candidate more. Then
        (:meth:`_ships`): the box is the extent of the object's pixels that are at least
-       half covered; the water-line point is the hull/sea edge at the middle of the
+       half covered, its left and right ends then to a fraction of a pixel where they
+       can be measured (:func:`_subpixel_ends`: the coverage integral across each end);
+       the water-line point is the hull/sea edge at the middle of the
        hull's columns, to a fraction of a pixel (:mod:`seawatch.vision.waterline`: per
        column the coverage integral of the unsmoothed intensity step between the hull's
        and the sea's levels — or colours —, which neither the smoothing, the threshold
