@@ -688,6 +688,54 @@ def test_ship_in_front_of_another_gives_two_boxes_with_their_own_water_lines(ref
     _own_sides(det, truth, found)  # the far ship spans the near one
 
 
+def test_merge_rule_keeps_a_boat_at_a_ship_s_corner_apart_but_not_glitter():
+    """:meth:`ClassicalShipDetector._mergeable` on the crossing case's own candidates
+    (working pixels): the ships' box and the boat hanging below its bottom at a corner
+    stay apart; the same geometry of bright-only boxes (glitter) merges; a
+    superstructure on its hull (sharing its columns) and two pieces of a hull side by
+    side (sharing their rows) merge."""
+    from seawatch.vision.detect import _Candidate
+
+    def cand(box, polarity):
+        return _Candidate(np.array(box, float), 1, 10.0, polarity)
+
+    rule = ClassicalShipDetector()._mergeable
+    ships, boat = [441, 132, 536, 152], [426, 150, 442, 158]
+    assert not rule(cand(ships, 2), cand(boat, 3))
+    assert not rule(cand(boat, 3), cand(ships, 2))  # either order
+    assert rule(cand(ships, 1), cand(boat, 1))  # glitter
+    assert rule(cand([470, 120, 500, 131], 2), cand([441, 132, 536, 152], 2))  # stacked
+    assert rule(cand([441, 140, 480, 152], 2), cand([483, 141, 536, 152], 2))  # side by side
+
+
+def test_a_nearer_boat_at_a_far_ship_s_corner_is_boxed_alone():
+    """The rendered crossing case (seed 0, 960 × 540, lossless) in its last second: the
+    14 × 5 px boat passes under the container ship's bow, its top in the ship's bottom
+    rows and its columns reaching 1-2 of the ship's. Its box is its own in each frame
+    (within 1.5 px of its centre, its width within 30 %). Before, the two candidates,
+    overlapping at a corner, were merged, and the boat, the container ship and the
+    ferry were one 117-123 px box in frames 182, 191 and 194."""
+    from seawatch.synth.cases import ship_video_case
+    from seawatch.synth.render import Renderer
+    from seawatch.vision.horizon import HorizonTracker
+
+    case = ship_video_case("crossing", duration=8.0, width=960, height=540, seed=0)
+    renderer = Renderer(case.camera, case.ships, 25.0, lighting=case.lighting,
+                        sway=case.sway, coastline=case.coastline, seed=case.seed)  # fmt: skip
+    detector, horizon = ClassicalShipDetector(), HorizonTracker(fps=25.0)
+    for index in range(178, 195):
+        frame = renderer.frame(index)
+        img = frame.bgr()
+        det = detector(img, horizon=horizon.update(img))
+        if index not in (182, 191, 194):
+            continue
+        boat = next(o for o in frame.objects if o.object_id == 3)
+        cx, cy = det.x + det.w / 2, det.y + det.h / 2
+        near = np.hypot(cx - boat.x - boat.w / 2, cy - boat.y - boat.h / 2) < 1.5
+        own = near & (np.abs(det.w - boat.w) < 0.3 * boat.w)
+        assert own.any(), (index, det.boxes[:, :4].round(1), (boat.x, boat.y, boat.w, boat.h))
+
+
 @pytest.mark.parametrize("seed", [1234, 99])
 def test_ship_one_pixel_nearer_than_the_one_behind_it_gives_two_boxes(seed):
     """Two ships whose water lines are 1.0 px apart (a 40 px ship in front of the middle
