@@ -2073,11 +2073,11 @@ def _subpixel_ends(
     x0 = fx0 - lo  # the mask's first column in the crop
     for side in (0, 1):
         a = x0 - 2 if side == 0 else x0 + nc - 2  # the coverage window a … a + 3
-        fa = a - _END_FLANK if side == 0 else a + 4  # the background fa … fa + 3
+        fa = a - _END_FLANK if side == 0 else a + 4  # the background beside the window
         if fa < 0 or fa + _END_FLANK > hi - lo:
             continue
         reach = np.ascontiguousarray(ship[:, 0 if side == 0 else -1])
-        total = _end_kernel(img, reach, a, fa, x0 + 1, x0 + nc - 1, side, _END_SIGMA)
+        total = _end_kernel(img, reach, a, fa, _END_FLANK, x0 + 1, x0 + nc - 1, side, _END_SIGMA)
         if math.isnan(total):
             continue
         end = lo + (a + 3.5 - total if side == 0 else a - 0.5 + total)
@@ -2087,14 +2087,14 @@ def _subpixel_ends(
 
 
 @njit(cache=True, nogil=True)
-def _end_kernel(img, reach, a, fa, i0, i1, side, max_sigma):  # pragma: no cover - compiled
+def _end_kernel(img, reach, a, fa, nflank, i0, i1, side, max_sigma):  # pragma: no cover
     """Σ f over the coverage window ``a … a + 3`` of one end (:func:`_subpixel_ends`), or
     NaN where it cannot be measured: ``img`` (rows, cols, channels) float32, ``reach``
-    the rows that reach the end, background columns ``fa … fa + 3``, inner columns
-    ``i0 … i1 − 1``, ``side`` 0 left / 1 right. Compiled: a handful of small medians
-    per end, a few µs instead of the ~0.3 ms of numpy calls on arrays this small."""
+    the rows that reach the end, background columns ``fa … fa + nflank − 1``, inner
+    columns ``i0 … i1 − 1``, ``side`` 0 left / 1 right, ``max_sigma`` the largest noise
+    [px] of the end. Compiled: a handful of small medians per end, a few µs instead of
+    the ~0.3 ms of numpy calls on arrays this small."""
     nch = img.shape[2]
-    nflank = 4
     rows = np.flatnonzero(reach)
     n = rows.size
     ni = i1 - i0
