@@ -669,6 +669,13 @@ class _Frame:
         (float32; converted from the colour frame on demand)."""
         return self.grey_rows(y0, y1)[:, x0:x1].astype(np.float32)
 
+    def ycc_crop(self, y0: int, y1: int, x0: int, x1: int) -> NDArray:
+        """Rows ``y0 … y1 − 1``, columns ``x0 … x1 − 1`` of the colour frame in (Y, Cr,
+        Cb) (float32, (rows, columns, 3)); a colour frame only."""
+        assert self.colour is not None
+        crop = np.ascontiguousarray(self.colour[y0:y1, x0:x1])
+        return cv2.cvtColor(crop, cv2.COLOR_BGR2YCrCb).astype(np.float32)
+
     def grey_rows(self, y0: int, y1: int) -> NDArray:
         """Rows ``y0 … y1 − 1`` (within the frame) of the full-resolution grey frame, all
         columns (converted from a colour frame once per row and kept)."""
@@ -1792,8 +1799,7 @@ class ClassicalShipDetector:
         r0, r1, c0, c1 = _mask_extent(union)
         r0, c0, r1, c1 = max(0, r0 - 2), max(0, c0 - 2), min(nr, r1 + 3), min(nc, c1 + 3)
         ycc_s = _line_samples(fr, Y0, nr, cols, slope * (cols - cm), colour=True)
-        crop = np.ascontiguousarray(fr.colour[Y0 + r0 : Y0 + r1, X0 + c0 : X0 + c1])
-        ycc = cv2.cvtColor(crop, cv2.COLOR_BGR2YCrCb).astype(np.float32)
+        ycc = fr.ycc_crop(Y0 + r0, Y0 + r1, X0 + c0, X0 + c1)
         dist = np.zeros((nr, nc), np.float32)
         part_d = diff[r0:r1, c0:c1]
         acc = part_d * part_d
@@ -1873,8 +1879,7 @@ def _chroma_contrast(
     level's chroma backgrounds and noise sampled at its working coordinates (mx, my)."""
     assert fr.colour is not None and lv.chroma is not None
     x0, y0, x1, y1 = crop
-    col = np.ascontiguousarray(fr.colour[y0:y1, x0:x1])
-    ycc = cv2.cvtColor(col, cv2.COLOR_BGR2YCrCb).astype(np.float32)
+    ycc = fr.ycc_crop(y0, y1, x0, x1)
     ycc = cv2.GaussianBlur(ycc, (3, 3), 0.8, borderType=cv2.BORDER_REPLICATE)[inner]
     cx, cy = (mx + 0.5) / 2 - 0.5, (my + 0.5) / 2 - 0.5  # half-resolution planes
     remap = {"interpolation": cv2.INTER_LINEAR, "borderMode": cv2.BORDER_REPLICATE}
@@ -2064,8 +2069,7 @@ def _subpixel_ends(
     lo = max(0, fx0 - 2 - _END_FLANK)  # the frame's columns lo … hi − 1 are read
     hi = min(W, fx0 + nc + 2 + _END_FLANK)
     if fr.colour is not None:
-        crop = np.ascontiguousarray(fr.colour[fy0 : fy0 + nr, lo:hi])
-        img = cv2.cvtColor(crop, cv2.COLOR_BGR2YCrCb).astype(np.float32)
+        img = fr.ycc_crop(fy0, fy0 + nr, lo, hi)
     else:
         img = fr.grey_crop(fy0, fy0 + nr, lo, hi)[:, :, None]
     ends = [fx0 - 0.5, fx0 + nc - 0.5]  # the mask's

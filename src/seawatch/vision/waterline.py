@@ -23,7 +23,6 @@ import itertools
 import math
 from typing import TYPE_CHECKING
 
-import cv2
 import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
@@ -523,8 +522,7 @@ def _frame_ships(
     h, w = obj.shape
     y1 = min(fr.shape[0], y0 + h + _WL_BELOW)
     if colour and fr.colour is not None:  # (Y, Cr, Cb): a hull may differ in colour only
-        crop = np.ascontiguousarray(fr.colour[y0:y1, x0 : x0 + w])
-        raw = cv2.cvtColor(crop, cv2.COLOR_BGR2YCrCb).astype(np.float32)
+        raw = fr.ycc_crop(y0, y1, x0, x0 + w)
     else:
         raw = fr.grey_crop(y0, y1, x0, x0 + w)
     mask = np.zeros(raw.shape[:2], dtype=bool)
@@ -532,8 +530,7 @@ def _frame_ships(
     cols, bottom, top, edge = _column_edges(raw, mask, fr.quantum)
     # the hull's colour (Y, Cr, Cb; grey for a grey frame) per column, from the sea's
     if fr.colour is not None and not colour:
-        crop = np.ascontiguousarray(fr.colour[y0:y1, x0 : x0 + w])
-        rgb = cv2.cvtColor(crop, cv2.COLOR_BGR2YCrCb).astype(np.float32)
+        rgb = fr.ycc_crop(y0, y1, x0, x0 + w)
     else:
         rgb = raw if raw.ndim == 3 else raw[:, :, None]
     hull, noise = _hull_contrast_kernel(np.ascontiguousarray(rgb), cols, bottom)
