@@ -178,8 +178,10 @@ class Detector(Protocol):
 # --------------------------------------------------------------------------------------
 
 
-def _horizon_ends(horizon: Any, width: int) -> tuple[float, float] | None:
-    """Rows [px] of the horizon line at columns 0 and ``width - 1``, or None."""
+def _horizon_points(horizon: Any) -> tuple[float, float, float, float] | None:
+    """A horizon's line ``(x0, y0, x1, y1)`` [px], from an object with those attributes
+    (a :class:`~seawatch.vision.horizon.HorizonEstimate`) or four numbers; None for None,
+    a horizon not found or a line written as NaN."""
     if horizon is None:
         return None
     if hasattr(horizon, "x0"):
@@ -200,6 +202,15 @@ def _horizon_ends(horizon: Any, width: int) -> tuple[float, float] | None:
         raise ValueError(f"horizon: expected four numbers x0, y0, x1, y1, got {pts!r}") from None
     if not all(math.isfinite(v) for v in (x0, y0, x1, y1)):
         return None  # a "not found" line written as NaN
+    return x0, y0, x1, y1
+
+
+def _horizon_ends(horizon: Any, width: int) -> tuple[float, float] | None:
+    """Rows [px] of the horizon line at columns 0 and ``width - 1``, or None."""
+    line = _horizon_points(horizon)
+    if line is None:
+        return None
+    x0, y0, x1, y1 = line
     if x1 == x0:
         raise ValueError("horizon: x0 == x1, the line is vertical (not a horizon)")
     slope = (y1 - y0) / (x1 - x0)

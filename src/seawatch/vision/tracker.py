@@ -64,7 +64,7 @@ from seawatch.filters import (
     KalmanFilter,
 )
 from seawatch.tracking.mtt import MultiTargetTracker, TrackStates
-from seawatch.vision.detect import ClassicalShipDetector, Detections
+from seawatch.vision.detect import ClassicalShipDetector, Detections, _horizon_points
 from seawatch.vision.motion import CameraMotion
 
 __all__ = [
@@ -397,16 +397,8 @@ class VisualTracker:
         no horizon is found — their linear prediction (at most :data:`LINE_HOLD` frames
         ahead); a line that stays outside the gate for :data:`LINE_HOLD` frames is taken
         (the camera did move)."""
-        line = None
-        if horizon is not None and getattr(horizon, "found", True):
-            line = as_float_array(
-                "horizon",
-                [horizon.x0, horizon.y0, horizon.x1, horizon.y1]
-                if hasattr(horizon, "x0")
-                else horizon,
-            ).reshape(4)
-            if not np.all(np.isfinite(line)) or line[2] == line[0]:
-                line = None
+        points = _horizon_points(horizon)
+        line = None if points is None or points[2] == points[0] else np.array(points)
         if self._line is None:  # not yet settled: lines that follow each other
             if line is None:
                 return None
