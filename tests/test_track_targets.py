@@ -43,11 +43,11 @@ SMALL = {"width": 960, "height_px": 540, "fps": 5.0}
 XFAIL: dict[tuple[str, str], str] = {
     ("uav-sea", "rmse30"): (
         "issue 7 'EKF 30 % below point-wise geometry' not met since the horizon refines "
-        "the attitude in every frame it is found (session 17): EKF 51.7 m vs geometry "
+        "the attitude in every frame it is found (session 17): EKF 51.6 m vs geometry "
         "58.0 m (ratio 0.89; 1080p: 16.6 vs 19.4 m, 0.86); both were worse before, when "
         "frames under confidence 0.5 took the attitude without the sway: EKF 74.6 m, "
         "geometry 166.0 m (ratio 0.45). What is left is a bias, which no filtering "
-        "removes: at 1080p the EKF's range error is 2.77 % RMS with a mean of -2.72 % "
+        "removes: at 1080p the EKF's range error is 2.78 % RMS with a mean of -2.73 % "
         "at 250-500 m and 4.19 % with -4.10 % at 500-750 m (about 0.27 px on the "
         "water line)"
     ),
