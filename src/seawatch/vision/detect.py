@@ -488,6 +488,9 @@ def _shear_half_kernel(src, starts, fy, out):  # pragma: no cover - compiled
 _REFINE_FLOOR = 0.15
 """Least mask threshold of the candidate refinement as a fraction of the candidate's 95th
 percentile contrast (``ClassicalShipDetector._refine_mask``)."""
+_BESIDE_RATIO = 2.0 / 3.0
+"""An object mask's pixels of the other polarity beyond its own polarity's columns are
+dropped when under this fraction of its strongest pixel (:func:`_beside_ends`)."""
 
 
 def _percentile(a: NDArray, q: float) -> float:
@@ -1661,13 +1664,15 @@ class ClassicalShipDetector:
         inner = (slice(fy0 - gy0, fy0 - gy0 + fy1 - fy0), slice(fx0 - gx0, fx0 - gx0 + fx1 - fx0))
         g = fr.grey_crop(gy0, gy1, gx0, gx1)
         g = cv2.GaussianBlur(g, (3, 3), 0.8, borderType=cv2.BORDER_REPLICATE)[inner]
+        sig = cv2.remap(lv.sigma, mx, my, **remap)  # in noise units, like z
+        bright_res = dark_res = None
         if self.polarity == "bright":
-            res = g - hi
+            res = (g - hi) / sig
         elif self.polarity == "dark":
-            res = lo - g
+            res = (lo - g) / sig
         else:
-            res = np.maximum(g - hi, lo - g)
-        res /= cv2.remap(lv.sigma, mx, my, **remap)  # in noise units, like z
+            bright_res, dark_res = (g - hi) / sig, (lo - g) / sig
+            res = np.maximum(bright_res, dark_res)
         chroma = False
         if lv.chroma and fr.colour is not None:
             luma = res.copy()
@@ -1696,6 +1701,16 @@ class ClassicalShipDetector:
         if not touching.any():
             return []
         sel = touching[labels] if n > 2 else labels > 0
+        if bright_res is not None and dark_res is not None:
+            trimmed = _beside_ends(sel, bright_res, dark_res, thr, (cy0, cy1, cx0, cx1))
+            if trimmed is not sel:  # what is still joined to the candidate
+                n, labels = cv2.connectedComponents(trimmed.view(np.uint8), connectivity=8)
+                touching = np.zeros(n, dtype=bool)
+                touching[labels[cy0:cy1, cx0:cx1].ravel()] = True
+                touching[0] = False
+                if not touching.any():
+                    return []
+                sel = touching[labels]
         win = (fx0, fy0, fx1, fy1)
         return self._ships(fr, win, sel, np.maximum(res, 0.0), chroma, keep=True) or []
 
@@ -1874,6 +1889,40 @@ class ClassicalShipDetector:
         gx1, gy1 = min(W, X1 + 1), min(H, Y1 + 1)
         inner = (slice(Y0 - gy0, Y1 - gy0), slice(X0 - gx0, X1 - gx0))
         return np.maximum(_chroma_contrast(fr, lv, (gx0, gy0, gx1, gy1), inner, mx, my), 0.0)
+
+
+def _beside_ends(
+    sel: NDArray[np.bool_],
+    bright: NDArray,
+    dark: NDArray,
+    thr: float,
+    core: tuple[int, int, int, int],
+) -> NDArray[np.bool_]:
+    """An object mask without the pixels of the other polarity than the candidate's
+    that lie beyond the columns of its own polarity's pixels
+    and stand out less than two thirds as much as its strongest pixel: a ship's parts
+    of either contrast (a pale superstructure on a dark hull) lie within its length,
+    while a sunlit haze or glare band behind a dark hull — brighter than the CFAR
+    background that the hull darkens around it — runs on beyond the hull's ends.
+    ``bright``, ``dark``: the polarities' contrasts (noise units) on the mask's grid;
+    ``thr``: the mask's threshold; ``core``: the candidate's own rows and columns of
+    that grid (r0, r1, c0, c1; ends exclusive), whose 95th percentiles of the two
+    contrasts give its polarity. Returns ``sel`` itself when nothing is dropped."""
+    r0, r1, c0, c1 = core
+    cb, cd = bright[r0:r1, c0:c1], dark[r0:r1, c0:c1]
+    if cb.size == 0 or not sel.any():
+        return sel
+    own_dark = _percentile(cd, 95.0) >= _percentile(cb, 95.0)
+    own, other = (dark, bright) if own_dark else (bright, dark)
+    own_px = sel & (own > thr) & (own >= other)
+    if not own_px.any():
+        return sel
+    cols = np.flatnonzero(own_px.any(axis=0))
+    beyond = np.ones(sel.shape[1], dtype=bool)
+    beyond[cols[0] : cols[-1] + 1] = False
+    weaker = other < _BESIDE_RATIO * float(own[own_px].max())
+    drop = sel & (other > own) & weaker & beyond[None, :]
+    return sel & ~drop if drop.any() else sel
 
 
 def _chroma_contrast(
