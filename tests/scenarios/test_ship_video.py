@@ -47,22 +47,25 @@ def test_bad_arguments_raise():
         run(cases=["large"], polarity="grey")
 
 
-def test_dark_polarity_drops_the_glitters_tracks_in_the_lighting_case():
+def test_dark_polarity_scores_the_lighting_case_as_well_as_both():
     """The lighting case faces a low sun: with the detector looking for dark ships only
-    (``polarity="dark"``), no glitter track takes the distant boat's CLE (8 s, three
-    renderings: afkf 4.09 → 2.66 %, README); on 4 s here 4.24 → 2.54 % (afkf), with
-    the ordering afkf ≤ fkf ≤ kf (2.54, 2.54, 2.64 %). (On 2 s, as up to session 18,
-    the ordering no longer holds since session 19's horizon-stabilised rows, which
-    start once the horizon has settled: afkf 2.60, kf 2.54 %; before, 2.40 and 2.47.
-    Before session 16's detector changes, which drop most glitter boxes with both
-    polarities too, the default gave 10.5 % on 2 s.)"""
+    (``polarity="dark"``) no glitter is boxed (its tracks: ``tests/test_track_outputs.py``),
+    and the scored ships' CLE is no worse than with both polarities, with the ordering
+    afkf ≤ fkf ≤ kf. On 4 s: both 2.32 %, dark 2.31 % (afkf). Up to session 20 the
+    glare beside the ferry's hull widened its boxes with both polarities and dark was
+    the clearly better: both 4.24 %, dark 2.54 % (8 s, three renderings: 3.95 against
+    2.52 %, README); since session 21's trimming of the other polarity beside and under
+    a hull (``seawatch.vision.detect._trim_other_polarity``) the two agree. (On 2 s, as
+    up to session 18, the ordering no longer holds since session 19's horizon-
+    stabilised rows, which start once the horizon has settled: afkf 2.60, kf 2.54 %.)"""
     opts = {"cases": ["lighting"], "duration": 4.0}
     both = run(**opts)
     dark = run(polarity="dark", **opts)
     assert dark.extra["polarity"] == "dark" and both.extra["polarity"] == "both"
     e_both = both.find("afkf", "cle_percent", case="lighting")["mean"]
     e_dark = dark.find("afkf", "cle_percent", case="lighting")["mean"]
-    assert e_dark < 0.75 * e_both, (e_dark, e_both)
+    assert e_dark <= 1.02 * e_both, (e_dark, e_both)
+    assert e_both < 3.0, e_both  # the glare no longer widens the ferry's boxes
     assert dark.extra["ordering"]["lighting"]
 
 

@@ -933,6 +933,31 @@ def test_dark_hull_in_front_of_a_glare_band_is_boxed_without_it(cx):
     assert np.all(np.abs(det.boxes[found[0], :4] - t[:4]) <= 1.0), (det.boxes[found[0]], t)
 
 
+@pytest.mark.parametrize("cx", [300.0, 320.5, 341.25])
+def test_glint_streak_under_part_of_a_dark_hull_is_no_part_of_it(cx):
+    """A dark hull (−120 grey levels, 56 × 5 px, with a superstructure) and a bright
+    glint streak (+45, 44 × 3 px) on the water under its first two thirds, touching its
+    water line — the rendered lighting case's ferry in frames 37–39 (seed 0). The
+    streak is the other polarity under the hull's lowest pixels, no part of the ship:
+    one box, within a pixel, its water line within half a pixel. Measured before
+    (session 21): the boxes 1.2 px too tall with their water lines 0.75–1.0 px low, and
+    at 320.5 the ship split where the streak ends (a 42.8 px box: two hulls over two
+    seas, one water line dragged down by the streak)."""
+    rng = np.random.default_rng(80)
+    base, _, hz = sea_scene(rng, 360, 640, 120.0, noise=0.0)
+    img = base.copy()
+    bright = min(255.0, float(np.median(base[200:240, 220:440])) + 45.0)
+    t = box_ship(img, base, cx, 210.5, 56, 5, -120, sup=(0.6, 5))
+    a = t[0] - 6.0
+    paint_polygon(img, [(a, 210.5), (a + 44.0, 210.5), (a + 44.0, 213.5), (a, 213.5)], bright)
+    img = as_u8(cv2.GaussianBlur(img, (0, 0), 0.7) + rng.normal(0, 2.0, img.shape))
+    det = ClassicalShipDetector()(img, horizon=hz)
+    found, _ = match(det, np.array([t]), tol=3.0)
+    assert found[0] >= 0, det.boxes
+    assert np.all(np.abs(det.boxes[found[0], :4] - t[:4]) <= 1.0), (det.boxes[found[0]], t)
+    assert abs(det.v_wl[found[0]] - t[5]) <= 0.5, (det.v_wl[found[0]], t[5])
+
+
 @pytest.mark.parametrize("refine", REFINE)
 def test_rendered_footage_water_line_matches_truth_within_the_renderers_fill(tmp_path, refine):
     """Rendered H.264 footage (``seawatch.synth.render``): a 50 m ferry 800 m out and a

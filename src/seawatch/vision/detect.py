@@ -488,9 +488,10 @@ def _shear_half_kernel(src, starts, fy, out):  # pragma: no cover - compiled
 _REFINE_FLOOR = 0.15
 """Least mask threshold of the candidate refinement as a fraction of the candidate's 95th
 percentile contrast (``ClassicalShipDetector._refine_mask``)."""
-_BESIDE_RATIO = 2.0 / 3.0
-"""An object mask's pixels of the other polarity beyond its own polarity's columns are
-dropped when under this fraction of its strongest pixel (:func:`_beside_ends`)."""
+_TRIM_RATIO = 2.0 / 3.0
+"""An object mask's pixels of the other polarity beyond its own polarity's columns or under
+them are dropped when under this fraction of its strongest pixel
+(:func:`_trim_other_polarity`)."""
 
 
 def _percentile(a: NDArray, q: float) -> float:
@@ -1702,7 +1703,7 @@ class ClassicalShipDetector:
             return []
         sel = touching[labels] if n > 2 else labels > 0
         if bright_res is not None and dark_res is not None:
-            trimmed = _beside_ends(sel, bright_res, dark_res, thr, (cy0, cy1, cx0, cx1))
+            trimmed = _trim_other_polarity(sel, bright_res, dark_res, thr, (cy0, cy1, cx0, cx1))
             if trimmed is not sel:  # what is still joined to the candidate
                 n, labels = cv2.connectedComponents(trimmed.view(np.uint8), connectivity=8)
                 touching = np.zeros(n, dtype=bool)
@@ -1891,7 +1892,7 @@ class ClassicalShipDetector:
         return np.maximum(_chroma_contrast(fr, lv, (gx0, gy0, gx1, gy1), inner, mx, my), 0.0)
 
 
-def _beside_ends(
+def _trim_other_polarity(
     sel: NDArray[np.bool_],
     bright: NDArray,
     dark: NDArray,
@@ -1899,11 +1900,13 @@ def _beside_ends(
     core: tuple[int, int, int, int],
 ) -> NDArray[np.bool_]:
     """An object mask without the pixels of the other polarity than the candidate's
-    that lie beyond the columns of its own polarity's pixels
-    and stand out less than two thirds as much as its strongest pixel: a ship's parts
-    of either contrast (a pale superstructure on a dark hull) lie within its length,
-    while a sunlit haze or glare band behind a dark hull — brighter than the CFAR
-    background that the hull darkens around it — runs on beyond the hull's ends.
+    that lie beyond the columns of its own polarity's pixels or under their lowest
+    one in a column, and stand out less than two thirds as much as its strongest
+    pixel: a ship's parts of either contrast (a pale superstructure on a dark hull) lie
+    within its length and above its water line, while a sunlit haze or glare band
+    behind a dark hull — brighter than the CFAR background that the hull darkens
+    around it — runs on beyond the hull's ends, and a glint streak (or a white hull's
+    shadow) lies on the water under it.
     ``bright``, ``dark``: the polarities' contrasts (noise units) on the mask's grid;
     ``thr``: the mask's threshold; ``core``: the candidate's own rows and columns of
     that grid (r0, r1, c0, c1; ends exclusive), whose 95th percentiles of the two
@@ -1918,10 +1921,13 @@ def _beside_ends(
     if not own_px.any():
         return sel
     cols = np.flatnonzero(own_px.any(axis=0))
-    beyond = np.ones(sel.shape[1], dtype=bool)
-    beyond[cols[0] : cols[-1] + 1] = False
-    weaker = other < _BESIDE_RATIO * float(own[own_px].max())
-    drop = sel & (other > own) & weaker & beyond[None, :]
+    outside = np.ones(sel.shape, dtype=bool)
+    outside[:, cols[0] : cols[-1] + 1] = False
+    rows = np.arange(sel.shape[0])[:, None]
+    low = np.where(own_px, rows, -1).max(axis=0)  # the own pixels' lowest row, per column
+    outside |= (rows > low) & (low >= 0)
+    weaker = other < _TRIM_RATIO * float(own[own_px].max())
+    drop = sel & (other > own) & weaker & outside
     return sel & ~drop if drop.any() else sel
 
 
