@@ -1917,7 +1917,10 @@ def _trim_other_polarity(
         return sel
     own_dark = _percentile(cd, 95.0) >= _percentile(cb, 95.0)
     own, other = (dark, bright) if own_dark else (bright, dark)
-    own_px = sel & (own > thr) & (own >= other)
+    mixed = sel & (other > own)  # the mask's pixels of the other polarity
+    if not mixed.any():
+        return sel
+    own_px = sel & (own > thr) & ~mixed
     if not own_px.any():
         return sel
     cols = np.flatnonzero(own_px.any(axis=0))
@@ -1927,7 +1930,7 @@ def _trim_other_polarity(
     low = np.where(own_px, rows, -1).max(axis=0)  # the own pixels' lowest row, per column
     outside |= (rows > low) & (low >= 0)
     weaker = other < _TRIM_RATIO * float(own[own_px].max())
-    drop = sel & (other > own) & weaker & outside
+    drop = mixed & weaker & outside
     return sel & ~drop if drop.any() else sel
 
 
