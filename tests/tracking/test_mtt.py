@@ -919,3 +919,53 @@ def test_occlusion_a_settled_ship_keeps_its_width_behind_a_boat_at_its_end():
             err = a_left + 20.0 - st.states[a, 0][0]
             assert abs(err) < 0.5, (k, err)
             assert st.boxes[a, 2][0] == pytest.approx(40.0, abs=0.5), k
+
+
+def test_a_ship_boxed_in_pieces_for_three_scans_is_one_track_again():
+    """A 56 × 13 px ship (moving 0.2 px a scan, centre noise 0.2 px) is boxed as two
+    pieces (38 and 17.5 px) in three scans: the small piece takes the ship's track and
+    the large one starts a second, and both are confirmed. Afterwards the ship's one box
+    is shared by the two tracks through their free edges (occlusion handling), and
+    before step 4b they kept the pieces' widths to the end: two boxes of 38 and 17.5 px
+    for one ship, 120 scans later. Now, 10 scans into the sharing (the box's width
+    unchanged), the track with more detections is restarted on the box and the other
+    deleted: one track, on the ship."""
+    trk = _visual_tracker()
+    rng = np.random.default_rng(0)
+    for k in range(160):
+        x = 100.0 + 0.2 * k
+        if 40 <= k < 43:
+            z = np.array([[x, 200.0, 38.0, 13.0], [x + 38.5, 203.0, 17.5, 10.0]])
+        else:
+            z = np.array([[x, 200.0, 56.0, 13.0]])
+        z[:, :2] += rng.normal(0.0, 0.2, (len(z), 2))
+        conf = trk.step(z).confirmed_tracks()
+        if k == 45:
+            assert len(conf) == 2  # the pieces' tracks, both confirmed
+        if k >= 60:
+            assert len(conf) == 1, (k, conf.boxes)
+            assert np.all(np.abs(conf.boxes[0] - [x, 200.0, 56.0, 13.0]) < 1.0), (k, conf.boxes)
+
+
+def test_two_ships_in_one_box_drifting_together_stay_two_tracks():
+    """Two ships (40 and 30 px, the second 1 px nearer) closing at 0.5 px a scan: from
+    scan 21 they are one box of both, whose ends are each ship's free end, each track
+    measured by its own (until scan 68, when the nearer one's far end comes within the
+    tolerance of the other's span and its track coasts). The box's width changes by
+    0.5 px a scan, so step 4b never takes them for one ship's pieces: both tracks live
+    through it with their widths and centres."""
+    trk = _visual_tracker()
+    shared = 0
+    for k in range(66):
+        a, b = 100.0 + 0.2 * k, 150.0 - 0.3 * k
+        if a + 40.0 > b:  # overlapping: one box of both
+            z = np.array([[a, 199.0, b + 30.0 - a, 12.0]])
+            shared += 1
+        else:
+            z = np.array([[a, 200.0, 40.0, 10.0], [b, 199.0, 30.0, 12.0]])
+        conf = trk.step(z).confirmed_tracks()
+        if k >= 5:
+            assert conf.ids.tolist() == [1, 2], (k, conf.ids)
+            np.testing.assert_allclose(conf.boxes[:, 2], [40.0, 30.0], atol=0.5)
+            np.testing.assert_allclose(conf.states[:, 0], [a + 20.0, b + 15.0], atol=1.0)
+    assert shared >= 40

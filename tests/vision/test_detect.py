@@ -33,6 +33,7 @@ from seawatch.vision.detect import (
     sea_region,
     waterline_points,
 )
+from seawatch.vision.detect import _trim_other_polarity as trim_other_polarity
 from seawatch.vision.external import (
     CallableDetector,
     MaskedDetector,
@@ -956,6 +957,45 @@ def test_glint_streak_under_part_of_a_dark_hull_is_no_part_of_it(cx):
     assert found[0] >= 0, det.boxes
     assert np.all(np.abs(det.boxes[found[0], :4] - t[:4]) <= 1.0), (det.boxes[found[0]], t)
     assert abs(det.v_wl[found[0]] - t[5]) <= 0.5, (det.v_wl[found[0]], t[5])
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(seed=st.integers(0, 10_000), dark=st.booleans(), thr=st.floats(0.5, 4.0))
+def test_trimming_keeps_the_own_polarity_and_what_lies_within_its_columns_above_its_bottom(
+    seed, dark, thr
+):
+    """Property of :func:`_trim_other_polarity` on random contrast planes: it only
+    removes pixels; it removes none of the candidate's own polarity, none of the other
+    polarity within the own pixels' columns and above their lowest one there, and none
+    that stands out at least 2/3 as much as the strongest own pixel; what it removes is
+    of the other polarity. Returns the mask itself when nothing is removed."""
+    rng = np.random.default_rng(seed)
+    h, w = int(rng.integers(3, 20)), int(rng.integers(3, 40))
+    own = np.abs(rng.normal(0.0, 3.0, (h, w))).astype(np.float32)
+    other = np.abs(rng.normal(0.0, 3.0, (h, w))).astype(np.float32)
+    r0, c0 = int(rng.integers(0, h - 1)), int(rng.integers(0, w - 1))
+    r1, c1 = int(rng.integers(r0 + 1, h + 1)), int(rng.integers(c0 + 1, w + 1))
+    own[r0:r1, c0:c1] += 6.0  # the candidate: its own polarity stands out over its pixels
+    sel = np.maximum(own, other) > thr
+    bright, darkp = (other, own) if dark else (own, other)
+    out = trim_other_polarity(sel, bright, darkp, thr, (r0, r1, c0, c1))
+    assert out.dtype == bool and out.shape == sel.shape
+    assert not np.any(out & ~sel)  # nothing added
+    removed = sel & ~out
+    if not removed.any():
+        assert out is sel
+        return
+    assert np.all(other[removed] > own[removed])  # only the other polarity goes
+    own_px = sel & (own > thr) & (own >= other)
+    assert own_px.any()
+    assert float(other[removed].max()) < 2.0 / 3.0 * float(own[own_px].max())
+    cols = np.flatnonzero(own_px.any(axis=0))
+    rows = np.arange(h)[:, None]
+    low = np.where(own_px, rows, -1).max(axis=0)
+    inside = np.zeros((h, w), bool)
+    inside[:, cols[0] : cols[-1] + 1] = True
+    inside &= ~((rows > low) & (low >= 0))
+    assert not np.any(removed & inside)
 
 
 @pytest.mark.parametrize("refine", REFINE)

@@ -40,6 +40,12 @@ image (pixels) or as points on the sea (metres). One scan:
    25 detections or more (its height settled) whose box keeps its water line but whose
    top rises above the track's by more than twice the tolerance has something behind
    the ship in its box (a ship beyond it, a coast): its top edge is blocked too.
+4b. **One ship's pieces** (boxes, ``occlusion``): two confirmed tracks that take the free
+   edges of one box in 10 scans in a row (:data:`_PIECES_SCANS`) while its width stays
+   within σ_z are one ship whose pieces (a hull split for a few frames) started a second
+   track: two ships in one box drift apart or together, these tracks would keep the
+   pieces' widths for ever. The one with more detections is restarted on the box, the
+   other deleted.
 5. **Manage tracks**: an unassigned detection starts a *tentative* track
    (``x0 = [z, 0, 0]``, ``P0 = diag(σ_z², σ_z², σ_v0², σ_v0²)``); a tentative track is
    *confirmed* once it has M detections among its last N scans (M-of-N, counting its
@@ -108,6 +114,9 @@ of a span or an extent counts as on it (:meth:`MultiTargetTracker._tolerance`)."
 _SETTLED_HITS = 25
 """Occlusion handling: detections after which a confirmed track's height is its ship's
 (a top that then rises while the water line stays is something behind the ship)."""
+_PIECES_SCANS = 10
+"""Occlusion handling: scans in a row in which two tracks take the free edges of one box
+of an unchanging width before they are taken for one ship's pieces (step 4b)."""
 _UNGATED = 1.0e12  # cost of a pair outside the gate inside the assignment solver
 
 
@@ -453,6 +462,10 @@ class MultiTargetTracker:
         self._own: tuple[FloatArray, FloatArray] | None = None  # _own_boxes of this scan
         self._S: FloatArray | None = None
         self._boxes: bool | None = None
+        # step 4b: per pair of track ids sharing one box, (scans in a row, least and
+        # largest box width, last scan)
+        self._pieces: dict[tuple[int, int], tuple[int, float, float, int]] = {}
+        self._scan = 0
 
     @property
     def n_tracks(self) -> int:
@@ -589,6 +602,9 @@ class MultiTargetTracker:
                 assigned[r2] = True
                 detection[r2] = valid[c2]
                 cols = np.concatenate([cols, c2])
+        dead = np.zeros(self.n_tracks, bool)
+        if boxes and edges is not None:  # 4b. one ship's pieces: one track again
+            dead = self._pieces_of_one(detection, anchored, centres, sizes)  # type: ignore[arg-type]
         # 5. track management
         mask_n = (1 << self.confirm_n) - 1
         self._history = ((self._history << 1) | assigned) & mask_n
@@ -602,7 +618,7 @@ class MultiTargetTracker:
         limit = np.full(self.n_tracks, float(self.delete_after))
         if self.coast_ratio is not None:
             limit = np.minimum(limit, np.maximum(self.coast_ratio * self._hits, 1.0))
-        keep = np.where(self._confirmed, self._misses < limit, can_confirm)
+        keep = np.where(self._confirmed, self._misses < limit, can_confirm) & ~dead
         self._compress(keep)
         detection = detection[keep]
         restarted = restarted[keep]
@@ -1155,6 +1171,51 @@ class MultiTargetTracker:
         self._size = self._size[keep]
         if self._filters:
             self._filters = [f for f, k in zip(self._filters, keep, strict=True) if k]
+
+    def _pieces_of_one(
+        self,
+        detection: NDArray[np.int64],
+        anchored: NDArray[np.bool_],
+        centres: FloatArray,
+        sizes: FloatArray,
+    ) -> NDArray[np.bool_]:
+        """Step 4b (module docstring): the tracks to delete because they and another
+        are one ship's pieces. Two confirmed tracks measured by one box (``detection``,
+        per track the index into ``centres``/``sizes`` of this scan) through their free
+        edges (``anchored``) in :data:`_PIECES_SCANS` consecutive scans, while the box's
+        width stays within σ_z: two ships in one box drift apart or together (a ship
+        coming out from behind another, crossing, overtaking), a ship boxed in pieces
+        for a few frames, whose pieces started a second track, does not — the two
+        tracks take the ends of its one box and keep the pieces' widths. The track with
+        more detections (the older on a tie) is restarted on the box (its id and
+        velocity kept, :meth:`_restart`); the other is returned for deletion.
+
+        Hand-written: a rule of this tracker's occlusion handling, which no library has."""
+        dead = np.zeros(self.n_tracks, bool)
+        self._scan += 1
+        book = self._pieces
+        idx = np.flatnonzero((detection >= 0) & anchored & self._confirmed)
+        for d in np.unique(detection[idx]):
+            pair = idx[detection[idx] == d]
+            if pair.size != 2:
+                continue
+            a, b = int(pair[0]), int(pair[1])
+            key = (int(min(self._ids[a], self._ids[b])), int(max(self._ids[a], self._ids[b])))
+            w = float(sizes[d, 0])
+            run, w_lo, w_hi, last = book.get(key, (0, w, w, -1))
+            if last != self._scan - 1:  # a new run
+                run, w_lo, w_hi = 0, w, w
+            run, w_lo, w_hi = run + 1, min(w_lo, w), max(w_hi, w)
+            book[key] = (run, w_lo, w_hi, self._scan)
+            if run >= _PIECES_SCANS and w_hi - w_lo <= self.sigma_z:
+                a_first = (self._hits[a], -self._ids[a]) >= (self._hits[b], -self._ids[b])
+                keep, other = (a, b) if a_first else (b, a)
+                self._restart(np.array([keep]), centres[d][None], sizes[d][None])
+                dead[other] = True
+                del book[key]
+        for key in [k for k, v in book.items() if v[3] != self._scan]:
+            del book[key]  # runs that ended
+        return dead
 
     def _birth(self, z: FloatArray, sizes: FloatArray | None) -> None:
         """Tentative tracks ``x0 = [z, 0, 0]``, ``P0 = diag(σ_z², σ_z², σ_v0², σ_v0²)``."""
