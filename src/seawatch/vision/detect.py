@@ -1694,24 +1694,14 @@ class ClassicalShipDetector:
         # stronger part (a dark hull under a pale superstructure) sets the 95th
         # percentile; never below a fraction of it (the strong part's halo)
         thr = min(0.4 * peak, max(self.threshold, _REFINE_FLOOR * peak))
-        obj = (res > thr).view(np.uint8)
-        n, labels = cv2.connectedComponents(obj, connectivity=8)
-        touching = np.zeros(n, dtype=bool)
-        touching[labels[cy0:cy1, cx0:cx1].ravel()] = True
-        touching[0] = False
-        if not touching.any():
-            return []
-        sel = touching[labels] if n > 2 else labels > 0
-        if bright_res is not None and dark_res is not None:
-            trimmed = _trim_other_polarity(sel, bright_res, dark_res, thr, (cy0, cy1, cx0, cx1))
+        own = (cy0, cy1, cx0, cx1)
+        sel = _joined(res > thr, own)
+        if sel is not None and bright_res is not None and dark_res is not None:
+            trimmed = _trim_other_polarity(sel, bright_res, dark_res, thr, own)
             if trimmed is not sel:  # what is still joined to the candidate
-                n, labels = cv2.connectedComponents(trimmed.view(np.uint8), connectivity=8)
-                touching = np.zeros(n, dtype=bool)
-                touching[labels[cy0:cy1, cx0:cx1].ravel()] = True
-                touching[0] = False
-                if not touching.any():
-                    return []
-                sel = touching[labels]
+                sel = _joined(trimmed, own)
+        if sel is None:
+            return []
         win = (fx0, fy0, fx1, fy1)
         return self._ships(fr, win, sel, np.maximum(res, 0.0), chroma, keep=True) or []
 
@@ -1890,6 +1880,19 @@ class ClassicalShipDetector:
         gx1, gy1 = min(W, X1 + 1), min(H, Y1 + 1)
         inner = (slice(Y0 - gy0, Y1 - gy0), slice(X0 - gx0, X1 - gx0))
         return np.maximum(_chroma_contrast(fr, lv, (gx0, gy0, gx1, gy1), inner, mx, my), 0.0)
+
+
+def _joined(mask: NDArray[np.bool_], core: tuple[int, int, int, int]) -> NDArray[np.bool_] | None:
+    """The 8-connected components of ``mask`` that hold a pixel of ``core`` (r0, r1, c0,
+    c1; ends exclusive), or None when none does."""
+    n, labels = cv2.connectedComponents(mask.view(np.uint8), connectivity=8)
+    r0, r1, c0, c1 = core
+    touching = np.zeros(n, dtype=bool)
+    touching[labels[r0:r1, c0:c1].ravel()] = True
+    touching[0] = False
+    if not touching.any():
+        return None
+    return touching[labels] if n > 2 else labels > 0
 
 
 def _trim_other_polarity(
