@@ -803,7 +803,10 @@ class ClassicalShipDetector:
        (default, :meth:`_refine_mask`): the pixels whose noise-normalised contrast
        against the level's CFAR backgrounds exceeds 0.4 × its 95th percentile p in the
        candidate, or the detection threshold where that is lower (at least 0.15 p), in
-       the components that touch it; ``refine="flank"``
+       the components that touch it, less the fainter pixels of the other polarity
+       beside the ends of the candidate's own and under them (a glare band behind a
+       dark hull, a glint streak under it: :func:`_trim_other_polarity`);
+       ``refine="flank"``
        (:meth:`_refine`, :meth:`_segment`): the object against a background of its own
        (per line parallel to the horizon, from flanks 1.5–3.5 object widths away), by
        polarity, with hysteresis, the window grown until the whole ship is in it —
@@ -1635,8 +1638,11 @@ class ClassicalShipDetector:
         chroma) exceeds 0.4 × its 95th percentile p over the candidate — or, where that is
         higher, the detection threshold itself, but at least 0.15 p (a superstructure
         five times fainter than its hull is still part of the ship) —, in the components
-        that touch the candidate; then :meth:`_ships` (half-covered pixels, sub-pixel
-        water line, ships whose water lines jump)."""
+        that touch the candidate (:func:`_joined`); with both polarities, less the
+        fainter pixels of the other polarity beside and under the candidate's own
+        (:func:`_trim_other_polarity`), in what is still joined to it; then
+        :meth:`_ships` (half-covered pixels, sub-pixel water line, ships whose water
+        lines jump)."""
         sx, sy = fr.sx, fr.sy
         H, W = fr.shape
         bx0, by0, bx1, by1 = fr.box_to_work(c.box)  # unsheared working pixels
