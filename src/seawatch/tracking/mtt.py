@@ -462,10 +462,9 @@ class MultiTargetTracker:
         self._own: tuple[FloatArray, FloatArray] | None = None  # _own_boxes of this scan
         self._S: FloatArray | None = None
         self._boxes: bool | None = None
-        # step 4b: per pair of track ids sharing one box, (scans in a row, least and
-        # largest box width, last scan)
-        self._pieces: dict[tuple[int, int], tuple[int, float, float, int]] = {}
-        self._scan = 0
+        # step 4b: per pair of track ids that shared one box in the last scan it ran,
+        # (scans in a row, least and largest box width)
+        self._pieces: dict[tuple[int, int], tuple[int, float, float]] = {}
 
     @property
     def n_tracks(self) -> int:
@@ -1192,8 +1191,7 @@ class MultiTargetTracker:
 
         Hand-written: a rule of this tracker's occlusion handling, which no library has."""
         dead = np.zeros(self.n_tracks, bool)
-        self._scan += 1
-        book = self._pieces
+        runs: dict[tuple[int, int], tuple[int, float, float]] = {}  # this scan's pairs
         idx = np.flatnonzero((detection >= 0) & anchored & self._confirmed)
         for d in np.unique(detection[idx]):
             pair = idx[detection[idx] == d]
@@ -1202,19 +1200,16 @@ class MultiTargetTracker:
             a, b = int(pair[0]), int(pair[1])
             key = (int(min(self._ids[a], self._ids[b])), int(max(self._ids[a], self._ids[b])))
             w = float(sizes[d, 0])
-            run, w_lo, w_hi, last = book.get(key, (0, w, w, -1))
-            if last != self._scan - 1:  # a new run
-                run, w_lo, w_hi = 0, w, w
+            run, w_lo, w_hi = self._pieces.get(key, (0, w, w))  # a run goes on or starts
             run, w_lo, w_hi = run + 1, min(w_lo, w), max(w_hi, w)
-            book[key] = (run, w_lo, w_hi, self._scan)
             if run >= _PIECES_SCANS and w_hi - w_lo <= self.sigma_z:
                 a_first = (self._hits[a], -self._ids[a]) >= (self._hits[b], -self._ids[b])
                 keep, other = (a, b) if a_first else (b, a)
                 self._restart(np.array([keep]), centres[d][None], sizes[d][None])
                 dead[other] = True
-                del book[key]
-        for key in [k for k, v in book.items() if v[3] != self._scan]:
-            del book[key]  # runs that ended
+            else:
+                runs[key] = (run, w_lo, w_hi)
+        self._pieces = runs  # a pair not sharing a box this scan ends its run
         return dead
 
     def _birth(self, z: FloatArray, sizes: FloatArray | None) -> None:
