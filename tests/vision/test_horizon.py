@@ -386,19 +386,40 @@ def test_rendered_coast_over_most_of_the_horizon_is_tracked_for_eight_seconds(tm
     6b's two lines — the coast's top and the straight sea horizon below it — score
     within a few hundredths by the region test, and alone each frame takes one or the
     other (the left end 7.2 px off on average). Through :class:`HorizonTracker` the
-    previous line weighs the close call, so the tracked line stays on the horizon:
-    both ends within 0.5 px in every frame it is found (measured 0.36 px at most;
-    before, 28.9). The straight line's confidence is 0.29–0.45 (the found threshold is
-    0.3): after five detections under it in a row the tracker reports one frame lost."""
+    previous line weighs the close call, so the tracked line stays on the horizon in
+    every frame: both ends within 1 px (measured 0.69 px at most, 0.12 px on average;
+    the worst frames follow weak detections 1.1–1.4 px off at one end, weighed by their
+    confidence 0.25–0.27). The straight line's confidence is 0.25–0.47 (the found
+    threshold is 0.3). Session 21's tracker, on session 22's host: five weak
+    detections in a row dropped the track at frame 12 (started again at once), and at
+    frame 169, with the prior 5 % of the height wide, the coast's top (0.404 by the
+    region test against the sea edge's 0.343) took the line, its left end 29 px up
+    for the rest of the clip."""
     tracker = HorizonTracker()
-    found = n = 0
+    n = 0
     for frame, (t0, t1) in _rendered(tmp_path, "crossing", 8.0, seed=0):
         n += 1
         est = tracker.update(frame.image, time=frame.time)
-        if est.found:
-            found += 1
-            assert abs(est.y0 - t0) < 0.5 and abs(est.y1 - t1) < 0.5, (frame.index, est.y0, t0)
-    assert n == 200 and found >= 198, (n, found)
+        assert est.found, frame.index
+        assert abs(est.y0 - t0) < 1.0 and abs(est.y1 - t1) < 1.0, (frame.index, est.y0, t0)
+    assert n == 200
+
+
+def test_rendered_glare_start_on_a_wrong_line_is_left_within_frames(tmp_path: Path):
+    """Rendered lighting case, seed 1 (low sun, its glare band on the horizon): the
+    first frame's line runs 19.6 px low at the right end, and the detections are right
+    from the third frame. A young track keeps the wide prior, so the tracked line is
+    within 0.5 px at both ends after a second (measured: from frame 21, its filter's
+    rate settling; with the tracker's own spread as the prior from the first frame, the
+    wrong line held for 30 frames)."""
+    errors = []
+    tracker = HorizonTracker()
+    for frame, (t0, t1) in _rendered(tmp_path, "lighting", 1.4, seed=1):
+        est = tracker.update(frame.image, time=frame.time)
+        assert est.found, frame.index
+        errors.append(max(abs(est.y0 - t0), abs(est.y1 - t1)))
+    assert len(errors) == 35 and errors[0] > 10.0  # the wrong start
+    assert max(errors[25:]) < 0.5, errors
 
 
 def test_rendered_coast_from_the_left_border_keeps_the_open_sea_end(coast_errors):
@@ -629,6 +650,26 @@ def test_tracker_gates_an_outlier_and_coasts_through_missed_frames():
     assert new.found and new.y0 == pytest.approx(300.0)
 
 
+def test_tracker_keeps_the_track_on_weak_detections_in_its_gate():
+    """A detection under the found threshold (0.3) by at most half, inside the gate,
+    updates the track, weighed by its confidence, instead of counting as a miss: a
+    horizon seen only between coasts keeps its track. Weaker ones, and weak ones
+    outside the gate, are misses."""
+    tracker = HorizonTracker(max_misses=3)
+    for k in range(10):
+        tracker.step(_detection(200.0, 210.0), k / 25)
+    for k in range(10, 20):  # ten weak detections 1 px lower: held and followed
+        est = tracker.step(_detection(201.0, 211.0, found=False, conf=0.2), k / 25)
+        assert est.found and tracker.misses == 0 and est.confidence == pytest.approx(0.2)
+    assert abs(est.y0 - 201.0) < 0.3 and tracker.age == 20  # (a step: the rate overshoots)
+    miss = tracker.step(_detection(201.0, 211.0, found=False, conf=0.1), 20 / 25)
+    assert miss.found and tracker.misses == 1  # under half the threshold: a miss
+    far = tracker.step(_detection(150.0, 160.0, found=False, conf=0.29), 21 / 25)
+    assert far.found and tracker.misses == 2 and far.y0 > 199.0  # outside the gate
+    lost = tracker.step(_detection(150.0, 160.0, found=False, conf=0.29), 22 / 25)
+    assert not lost.found and not tracker.tracking  # a weak one never starts a track
+
+
 def test_tracker_follows_a_real_jump_after_max_misses_frames():
     tracker = HorizonTracker(max_misses=4)
     for k in range(10):
@@ -662,6 +703,8 @@ def test_tracker_rejects_bad_options_and_times():
         HorizonTracker(sigma_a=-1.0)
     with pytest.raises(ValueError, match="detector"):
         HorizonTracker(colour="red")
+    with pytest.raises(ValueError, match="prior_sigma"):
+        detect_horizon(np.zeros((48, 64), np.uint8), prior_sigma=0.0)
     tracker = HorizonTracker()
     tracker.step(_detection(200.0, 200.0), 1.0)
     tracker.step(_detection(200.0, 200.0), 1.1)

@@ -54,8 +54,9 @@ the colour channels on the same scale. Then:
    centre with another tilt: the one with the better ``q · prior`` stands for them.
    ``prior = Π (0.5 + 0.5 exp(−d² / 2 σ_p²))`` over ``previous`` and
    the ``camera``'s nominal horizon (d = mean vertical distance between the lines,
-   σ_p = 5 % of the height): it favours, never forbids. The confidence is
-   ``sqrt(q · prior · (1 − exp(−r / 0.5)))`` in [0, 1]; ``found`` is
+   σ_p = 5 % of the height, or ``prior_sigma`` for ``previous`` where that is less:
+   :class:`HorizonTracker` gives its predicted spread): it favours, never forbids. The
+   confidence is ``sqrt(q · prior · (1 − exp(−r / 0.5)))`` in [0, 1]; ``found`` is
    ``confidence ≥ min_confidence`` (0.3).
 6. **Sub-pixel refinement on the full-resolution image.** Steps 1–5 locate the line
    to about a working row (``k`` image rows: 8 at 1080p); the reduction's sampling
@@ -1132,6 +1133,7 @@ def detect_horizon(
     work_width: int = 256,
     n_candidates: int = 6,
     min_confidence: float = 0.3,
+    prior_sigma: float | None = None,
 ) -> HorizonEstimate:
     """Detect the sea horizon in one image (module docstring: method and scores).
 
@@ -1148,6 +1150,9 @@ def detect_horizon(
             about this many columns (speed against precision).
         n_candidates: Hough peaks kept per gradient polarity.
         min_confidence: confidence at and above which ``found`` is True.
+        prior_sigma: how far from ``previous`` the line may be expected [px of
+            ``previous``'s image] (e.g. a tracker's predicted spread); the prior's
+            width σ_p is the smaller of this and 5 % of the height (None: 5 %).
 
     Returns:
         HorizonEstimate in the pixel coordinates of ``image``.
@@ -1160,6 +1165,10 @@ def detect_horizon(
         raise ValueError(f"n_candidates: expected an integer >= 1, got {n_candidates!r}")
     if not (0.0 <= min_confidence <= 1.0):
         raise ValueError(f"min_confidence: expected a value in [0, 1], got {min_confidence!r}")
+    if prior_sigma is not None and not (
+        isinstance(prior_sigma, int | float) and math.isfinite(prior_sigma) and prior_sigma > 0
+    ):
+        raise ValueError(f"prior_sigma: expected a positive number of pixels, got {prior_sigma!r}")
     if previous is not None and not isinstance(previous, HorizonEstimate):
         raise ValueError(f"previous: expected a HorizonEstimate or None, got {type(previous)}")
     arr = _as_image(image)
@@ -1190,7 +1199,7 @@ def detect_horizon(
         return result((h - 1) / 2.0, 0.0, 0.0)
 
     # prior lines in working coordinates (centre row, slope)
-    priors: list[tuple[float, float]] = []
+    priors: list[tuple[float, float, float]] = []
     tilt_centre = 0.0
     nominal = _nominal(camera, W, H)
     for est in (previous, nominal):
@@ -1198,7 +1207,10 @@ def detect_horizon(
             continue
         scale = H / est.height  # a line found at another resolution
         c_p, t_p = to_work((est.y0 + 0.5) * scale - 0.5, (est.y1 + 0.5) * scale - 0.5)
-        priors.append((c_p, t_p))
+        sigma = _PRIOR_SIGMA * h
+        if est is previous and prior_sigma is not None:
+            sigma = min(sigma, prior_sigma * scale / sy)
+        priors.append((c_p, t_p, sigma))
         if est is nominal:
             tilt_centre = math.atan(t_p)
 
@@ -1228,14 +1240,14 @@ def detect_horizon(
         for i, j in _local_maxima(E[k], n_candidates, rad_t, rad_c):
             raw.append((float(j), float(slopes[i]), float(E[k, i, j])))
     raw.sort(key=lambda r: -r[2])
-    starts = [(c, t) for c, t, _ in raw[: 2 * n_candidates]] + priors
+    starts = [(c, t) for c, t, _ in raw[: 2 * n_candidates]] + [p[:2] for p in priors]
 
     def prior_of(c: float, t: float) -> float:
         """The priors' weight of the working line (c, t): 1 on each, 0.5 far away."""
         prior = 1.0
-        for pc, pt in priors:
+        for pc, pt, sigma in priors:
             d = abs(c - pc) + 0.25 * w * abs(t - pt)  # mean |Δy| over the width
-            prior *= 0.5 + 0.5 * math.exp(-0.5 * (d / (_PRIOR_SIGMA * h)) ** 2)
+            prior *= 0.5 + 0.5 * math.exp(-0.5 * (d / sigma) ** 2)
         return prior
 
     # 3. refinement, 4. region statistics
@@ -1391,6 +1403,8 @@ def _strip_features(
 # --------------------------------------------------------------------------------------
 
 _CHI2_2DOF_999 = 13.815510557964274  # 99.9 % quantile of chi-square with 2 degrees of freedom
+_WEAK_FRACTION = 0.5  # a detection under the found threshold but above this × it, in the
+# gate, keeps the track (weighted by its confidence) instead of counting as a miss
 
 
 class HorizonTracker:
@@ -1404,17 +1418,31 @@ class HorizonTracker:
 
     1. predict to the frame time;
     2. run :func:`detect_horizon` with the predicted line as ``previous`` (a prior);
-    3. if the detection is found, gate it: innovation ``ν = z − H x⁻``,
-       ``S = H P⁻ Hᵀ + R``, ``NIS = νᵀ S⁻¹ ν``; with ``NIS ≤ gate`` (default the 99.9 %
-       point of χ²₂) it updates the filter (:class:`seawatch.filters.KalmanFilter`,
-       Joseph form) with ``R = (sigma_measurement / confidence)² I``; otherwise the
-       frame is predict-only (an outlier: a coastline, a wake, a glint);
+       once the track has held for a second of frames (``fps`` accepted detections),
+       with the prior's width the predicted spread of a detection about the line,
+       ``sqrt(max(P⁻₀₀, P⁻₁₁) + σ_m²)`` (σ_m = ``sigma_measurement``), where that is
+       under 5 % of the height: a coast on the horizon whose top scores about as well
+       as the sea's edge below it no longer takes the line in one frame (rendered
+       crossing, seed 0: the line had gone 29 px up at one end at frame 169 and stayed
+       there). A young track keeps the wide prior: it may have started on a wrong line;
+    3. if the detection is found — or is under the found threshold by at most half
+       (a weak detection, e.g. the sea's edge seen only between coasts) — gate it:
+       innovation ``ν = z − H x⁻``, ``S = H P⁻ Hᵀ + R``, ``NIS = νᵀ S⁻¹ ν``; with
+       ``NIS ≤ gate`` (default the 99.9 % point of χ²₂) it updates the filter
+       (:class:`seawatch.filters.KalmanFilter`, Joseph form) with
+       ``R = (sigma_measurement / confidence)² I``; otherwise the frame is
+       predict-only (an outlier: a coastline, a wake, a glint). A weak detection
+       that the gate accepts keeps the track like a found one (before, five in a row
+       dropped it, and the next frame started again without a prior);
     4. after ``max_misses`` consecutive frames without an accepted detection the track
-       is dropped: the output is ``found = False`` until a detection starts it again.
+       is dropped: the output is ``found = False`` until a found detection starts it
+       again.
 
     A detection that disagrees with the track for ``max_misses`` frames in a row therefore
     replaces it (the camera really moved). The output line is the filtered state; its
-    confidence is the detection's, or, while coasting, the last one times ``0.7 ** misses``.
+    confidence is the detection's (below the found threshold for a weak one), or, while
+    coasting, the last one times ``0.7 ** misses``. ``age`` counts the accepted
+    detections of the current track.
 
     Args:
         sigma_a: acceleration noise of the line ends [px/s²]; None = half an image
@@ -1471,6 +1499,7 @@ class HorizonTracker:
         self._time: float | None = None
         self._size: tuple[int, int] | None = None
         self.misses = 0
+        self.age = 0
         self._confidence = 0.0
         self.last_detection: HorizonEstimate | None = None
         self.last_nis: float = math.nan
@@ -1501,19 +1530,30 @@ class HorizonTracker:
         size = (int(arr.shape[1]), int(arr.shape[0]))
         if self._size is not None and size != self._size:
             self.reset()  # a new stream or a size change: start again
-        prior = None
+        prior, spread = None, None
         if self._kf is not None:
-            prior = self._predicted(time, size)
-        det = detect_horizon(arr, previous=prior, **self.detector)
+            prior, spread = self._predicted(time, size)
+            if self.age < self.fps:  # a young track may have started on a wrong line
+                spread = None
+        det = detect_horizon(arr, previous=prior, prior_sigma=spread, **self.detector)
         return self.step(det, time)
 
-    def _predicted(self, time: float | None, size: tuple[int, int]) -> HorizonEstimate:
-        """The track's line predicted to ``time`` (without changing the filter)."""
+    def _predicted(
+        self, time: float | None, size: tuple[int, int]
+    ) -> tuple[HorizonEstimate, float]:
+        """The track's line predicted to ``time`` and the spread of the next detection
+        about it [px] (without changing the filter): ``sqrt(max(P⁻₀₀, P⁻₁₁) + σ_m²)``,
+        the predicted covariance of the ends and a confident detection's variance."""
         assert self._kf is not None
         dt = self._dt(time)
         x = self._kf.x
         y0, y1 = float(x[0] + dt * x[2]), float(x[1] + dt * x[3])
-        return HorizonEstimate.from_endpoints(y0, y1, size[0], size[1], confidence=1.0)
+        sa, sm = self._scales(size[1])
+        F, Q = constant_velocity(2, dt, sa)
+        P = F @ self._kf.P @ F.T + Q
+        spread = math.sqrt(max(P[0, 0], P[1, 1]) + sm * sm)
+        line = HorizonEstimate.from_endpoints(y0, y1, size[0], size[1], confidence=1.0)
+        return line, spread
 
     def _dt(self, time: float | None) -> float:
         if time is None or self._time is None:
@@ -1547,6 +1587,7 @@ class HorizonTracker:
             self._size = size
             self._time = None if time is None else float(time)
             self.misses = 0
+            self.age = 1
             self._confidence = detection.confidence
             self.last_nis = 0.0
             return self._estimate(True, detection.confidence)
@@ -1559,7 +1600,8 @@ class HorizonTracker:
         self._time = None if time is None else float(time)
         accepted = False
         self.last_nis = math.nan
-        if detection.found:
+        floor = _WEAK_FRACTION * float(self.detector.get("min_confidence", 0.3))
+        if detection.found or detection.confidence >= floor:
             x, P = self._kf.x, self._kf.P
             nu = z - x[:2]
             S = P[:2, :2] + R
@@ -1569,6 +1611,7 @@ class HorizonTracker:
         if accepted:
             self._kf.update(z, R=R)
             self.misses = 0
+            self.age += 1
             self._confidence = detection.confidence
             return self._estimate(True, detection.confidence)
         self.misses += 1
