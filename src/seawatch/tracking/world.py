@@ -167,6 +167,7 @@ from scipy.stats import chi2
 from seawatch._validation import FloatArray, as_float_array, covariance, in_range, integer, positive
 from seawatch.filters.diffuse_rls import DiffuseRLS, DiffuseRLSBank
 from seawatch.geometry.sea import DEFAULT_REFRACTION, EARTH_RADIUS
+from seawatch.models.angles import wrap_angle
 
 __all__ = [
     "ESTIMATORS",
@@ -1242,9 +1243,8 @@ class WorldTracker:
         # a smoothed angle that has lost the measured one (AR predictions over missing
         # samples from a model not yet of full rank, kept in its regressors by λ = 1):
         # restart those tracks' AR models on this sample
-        sd = np.sqrt(np.stack([Sigma[:, 0, 0], Sigma[:, 1, 1]], axis=-1))
-        d_az = np.pi - np.mod(np.pi - (filt[:, 0] - az), 2.0 * np.pi)  # wrapped to (−π, π]
-        off = np.abs(np.stack([d_az, filt[:, 1] - dep], axis=-1))
+        sd = np.sqrt(np.diagonal(Sigma, axis1=1, axis2=2))
+        off = np.abs(np.stack([wrap_angle(filt[:, 0] - az), filt[:, 1] - dep], axis=-1))
         lost = np.any(off > RLS_RESTART_SIGMA * sd, axis=1)  # False where y is NaN
         if np.any(lost):
             again = self._rls.step(

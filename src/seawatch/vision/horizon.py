@@ -1548,12 +1548,21 @@ class HorizonTracker:
         dt = self._dt(time)
         x = self._kf.x
         y0, y1 = float(x[0] + dt * x[2]), float(x[1] + dt * x[3])
-        sa, sm = self._scales(size[1])
-        F, Q = constant_velocity(2, dt, sa)
+        F, Q = self._motion(dt, size[1])
+        sm = self._scales(size[1])[1]
         P = F @ self._kf.P @ F.T + Q
         spread = math.sqrt(max(P[0, 0], P[1, 1]) + sm * sm)
         line = HorizonEstimate.from_endpoints(y0, y1, size[0], size[1], confidence=1.0)
         return line, spread
+
+    def _motion(self, dt: float, height: int) -> tuple[np.ndarray, np.ndarray]:
+        """F and Q of the line ends over ``dt`` [s]: the filter's own for one frame
+        interval, else the CWNA model's for ``dt`` (``sigma_a`` of an image ``height``
+        px high)."""
+        assert self._kf is not None
+        if abs(dt * self.fps - 1.0) < 1e-6:
+            return self._kf.F, self._kf.Q
+        return constant_velocity(2, dt, self._scales(height)[0])
 
     def _dt(self, time: float | None) -> float:
         if time is None or self._time is None:
@@ -1591,12 +1600,8 @@ class HorizonTracker:
             self._confidence = detection.confidence
             self.last_nis = 0.0
             return self._estimate(True, detection.confidence)
-        dt = self._dt(time)
-        if abs(dt * self.fps - 1.0) < 1e-6:
-            self._kf.predict()  # one frame interval: the filter's own model
-        else:
-            F, Q = constant_velocity(2, dt, sa)
-            self._kf.predict(F=F, Q=Q)
+        F, Q = self._motion(self._dt(time), detection.height)
+        self._kf.predict(F=F, Q=Q)
         self._time = None if time is None else float(time)
         accepted = False
         self.last_nis = math.nan
