@@ -1335,3 +1335,62 @@ def test_a_ship_beside_another_is_boxed_whole_not_by_its_finest_scale_fragment()
             near = np.abs(det.x + 0.5 * det.w - (t.x + 0.5 * t.w)) < 12.0
             whole += int(np.any(near & (np.abs(det.w - t.w) <= 2.0)))
     assert whole >= 10, whole
+
+
+def _boat_beside_ship(seed: int) -> tuple[np.ndarray, tuple[float, float, float, float]]:
+    """A grey 960 × 540 frame: sky over a noisy sea (σ 2 grey levels), horizon at row 200
+    (edge at 199.5), a dark 56 × 13 px ship and, 18 px left of it, a dark 7 × 2 px boat
+    (pixels 535–541, rows 216–217)."""
+    rng = np.random.default_rng(seed)
+    img = np.full((540, 960), 160.0) + rng.normal(0.0, 2.0, (540, 960))
+    img[:200] = 190.0 + rng.normal(0.0, 1.0, (200, 960))
+    img[210:223, 560:616] -= 80.0
+    img[216:218, 535:542] -= 60.0
+    return np.clip(img, 0, 255).astype(np.uint8), (0.0, 199.5, 959.0, 199.5)
+
+
+@pytest.mark.parametrize("seed", [3, 4, 5])
+def test_censored_windows_find_the_boat_a_ship_beside_it_hides(seed):
+    """Greatest-of CFAR masks a weak target beside a strong one: the ship lies in the
+    boat's right training window and fills its noise cell (measured on the rendered
+    lighting case, z 2.4 against the threshold 6). With ``censor=True`` the candidates'
+    boxes are left out of the windows and cells around them and the boat is found, its
+    box to the pixel (534.5–541.5 × 215.5–217.5); the ship's box is unchanged."""
+    img, line = _boat_beside_ship(seed)
+    plain = ClassicalShipDetector()(img, horizon=line).boxes
+    censored = ClassicalShipDetector(censor=True)(img, horizon=line).boxes
+    assert plain.shape[0] == 1 and abs(plain[0, 0] - 559.5) < 1.0  # the ship alone
+    assert censored.shape[0] == 2
+    ship = censored[np.argmax(censored[:, 2])]
+    boat = censored[np.argmin(censored[:, 2])]
+    np.testing.assert_array_equal(ship, plain[0])
+    np.testing.assert_allclose(boat[:4], [534.5, 215.5, 7.0, 2.0], atol=0.5)
+
+
+def test_censoring_keeps_every_box_and_adds_only_parts_of_ships():
+    """Rolled colour scenes with a coast and ships apart: every box of the plain
+    detector is kept as it was; a box the censored pass adds lies on a ship — measured:
+    the right end (458.5–464.1 px) of the 90-px ship at roll −2°, whose box without it
+    ends at 452.5 px (the CFAR's own shadow on a long hull) — never on open sea."""
+    rng = np.random.default_rng(99)
+    added = 0
+    for roll in (-2.0, 0.0, 2.5):
+        img, truth, line = sea_scene(rng, roll_deg=roll, ships=fixed_ships(), coast=True)
+        plain = ClassicalShipDetector()(as_u8(img), horizon=line).boxes
+        censored = ClassicalShipDetector(censor=True)(as_u8(img), horizon=line).boxes
+        assert plain.shape[0] >= 4
+        kept = [any(np.array_equal(p, c) for c in censored) for p in plain]
+        assert all(kept)
+        for c in censored:
+            if any(np.array_equal(p, c) for p in plain):
+                continue
+            added += 1
+            cx, cy = c[0] + c[2] / 2, c[1] + c[3] / 2
+            on_ship = (
+                (truth[:, 0] <= cx)
+                & (cx <= truth[:, 0] + truth[:, 2])
+                & (truth[:, 1] <= cy)
+                & (cy <= truth[:, 1] + truth[:, 3])
+            )
+            assert on_ship.any(), c
+    assert added >= 1  # the roll −2° scene's ship end
