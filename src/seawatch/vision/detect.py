@@ -351,74 +351,75 @@ def _contrast_kernel(  # pragma: no cover - compiled
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def _censored_contrast_kernel(  # pragma: no cover - compiled
-    gs, b5, keep, r0, r1, guard, flank, polarity, min_count, hi, lo, d, c, tex
+    gs, b5, keep, r0, r1, c0, c1, guard, flank, polarity, min_count, hi, lo, d, c, tex
 ):
-    """:func:`_contrast_kernel` for rows ``r0 … r1 − 1`` with censored training windows:
-    only pixels with ``keep`` (uint8, 1) count, so another target (or its part) in a
-    window neither shifts the background mean nor raises the detail. A window with fewer
-    than ``min_count`` kept pixels (it left the image, or holds mostly an object) is
-    void; one void side takes the other's value, two void sides give ``c = d = tex = 0``
-    and ``hi = lo = g``. Outputs are (r1 − r0, W)."""
+    """:func:`_contrast_kernel` on rows ``r0 … r1 − 1``, columns ``c0 … c1 − 1`` with
+    censored training windows: only pixels with ``keep`` (uint8, 1) count, so another
+    target (or its part) in a window neither shifts the background mean nor raises the
+    detail. A window with fewer than ``min_count`` kept pixels (it left the image, or
+    holds mostly an object) is void; one void side takes the other's value, two void
+    sides give ``c = d = tex = 0`` and ``hi = lo = g``. Outputs are (r1 − r0, c1 − c0)."""
     H, W = gs.shape
-    P = np.zeros(W + 1)
-    Q = np.zeros(W + 1)
-    N = np.zeros(W + 1)
+    a = max(0, c0 - guard - flank)  # prefix sums over the columns the windows reach
+    b = min(W, c1 + guard + flank + 1)
+    P = np.zeros(b - a + 1)
+    Q = np.zeros(b - a + 1)
+    N = np.zeros(b - a + 1)
     for r in range(r0, r1):
         ra, rb = max(r - 1, 0), min(r + 1, H - 1)
         acc = 0.0
         acc2 = 0.0
         accn = 0.0
-        for j in range(W):
-            v = 0.0
-            q = 0.0
-            n = 0.0
-            for rr in (ra, r, rb):
-                if keep[rr, j]:
-                    e = gs[rr, j] - b5[rr, j]
-                    v += np.float64(gs[rr, j])
-                    q += np.float64(e * e)
-                    n += 1.0
-            acc += v
-            acc2 += q
-            accn += n
-            P[j + 1] = acc
-            Q[j + 1] = acc2
-            N[j + 1] = accn
+        g0, g1, g2 = gs[ra], gs[r], gs[rb]
+        m0, m1, m2 = b5[ra], b5[r], b5[rb]
+        k0, k1, k2 = keep[ra], keep[r], keep[rb]
+        for j in range(a, b):  # branch-free: a kept pixel counts with weight 1
+            w0, w1, w2 = np.float64(k0[j]), np.float64(k1[j]), np.float64(k2[j])
+            e0 = g0[j] - m0[j]
+            e1 = g1[j] - m1[j]
+            e2 = g2[j] - m2[j]
+            acc += w0 * g0[j] + w1 * g1[j] + w2 * g2[j]
+            acc2 += w0 * np.float64(e0 * e0) + w1 * np.float64(e1 * e1) + w2 * np.float64(e2 * e2)
+            accn += w0 + w1 + w2
+            P[j - a + 1] = acc
+            Q[j - a + 1] = acc2
+            N[j - a + 1] = accn
         o = r - r0
-        for j in range(W):
-            a0, a1 = max(0, j - guard - flank), max(0, j - guard)
-            b0, b1 = min(W, j + guard + 1), min(W, j + guard + 1 + flank)
-            nl = N[a1] - N[a0]
-            nr = N[b1] - N[b0]
+        for j in range(c0, c1):
+            k = j - c0
+            l0, l1 = max(0, j - guard - flank) - a, max(0, j - guard) - a
+            m0, m1 = min(W, j + guard + 1) - a, min(W, j + guard + 1 + flank) - a
+            nl = N[l1] - N[l0]
+            nr = N[m1] - N[m0]
             okl = nl >= min_count
             okr = nr >= min_count
+            g = np.float64(gs[r, j])
             if not okl and not okr:
-                hi[o, j] = gs[r, j]
-                lo[o, j] = gs[r, j]
-                c[o, j] = 0.0
-                d[o, j] = 0.0
-                tex[o, j] = 0.0
+                hi[o, k] = g
+                lo[o, k] = g
+                c[o, k] = 0.0
+                d[o, k] = 0.0
+                tex[o, k] = 0.0
                 continue
-            L = (P[a1] - P[a0]) / nl if okl else 0.0
-            EL = (Q[a1] - Q[a0]) / nl if okl else 0.0
-            R = (P[b1] - P[b0]) / nr if okr else L
-            ER = (Q[b1] - Q[b0]) / nr if okr else EL
+            L = (P[l1] - P[l0]) / nl if okl else 0.0
+            EL = (Q[l1] - Q[l0]) / nl if okl else 0.0
+            R = (P[m1] - P[m0]) / nr if okr else L
+            ER = (Q[m1] - Q[m0]) / nr if okr else EL
             if not okl:
                 L = R
                 EL = ER
-            g = np.float64(gs[r, j])
             h = max(L, R)
             lw = min(L, R)
-            hi[o, j] = h
-            lo[o, j] = lw
-            d[o, j] = g - 0.5 * (L + R)
-            tex[o, j] = np.sqrt(max(0.0, min(EL, ER)))
+            hi[o, k] = h
+            lo[o, k] = lw
+            d[o, k] = g - 0.5 * (L + R)
+            tex[o, k] = np.sqrt(max(0.0, min(EL, ER)))
             if polarity == 1:
-                c[o, j] = g - h
+                c[o, k] = g - h
             elif polarity == 2:
-                c[o, j] = lw - g
+                c[o, k] = lw - g
             else:
-                c[o, j] = max(g - h, lw - g)
+                c[o, k] = max(g - h, lw - g)
 
 
 @njit(cache=True, nogil=True)
@@ -716,9 +717,10 @@ class PreparedFrame:
 _NO_SIGN = np.full((1, 1), 3, np.uint8)  # one polarity only: every pixel joins
 
 _CENSOR_GAP = 3
-"""Least gap [working px] between a candidate and a target found beside it with censored
+"""Least gap [working px] above or below a candidate to a target found with censored
 windows (:meth:`ClassicalShipDetector._censored`): nearer, it is the candidate's own
-rim (the smoothing spreads a hull by a pixel, the box grows by one more)."""
+rim (the smoothing spreads a hull by a pixel, the box grows by one more). Beside it the
+gap is the CFAR's ``guard``."""
 
 
 @dataclass
@@ -878,7 +880,7 @@ class ClassicalShipDetector:
        superstructure) are merged when they overlap on one axis with a gap of at most
        ``merge_gap`` × the smaller height on the other; a bright and a dark one only
        when the bright one is stacked on the dark one (:meth:`_mergeable`).
-       With ``censor=True`` (off by default) the targets the candidates hide are looked
+       With ``censor=True`` (the default) the targets the candidates hide are looked
        for too (:meth:`_censored`): around them the finest scale is computed again with
        their boxes left out of the training windows and noise cells, and components
        clear of every candidate join as candidates of their own (merged only with one
@@ -966,7 +968,7 @@ class ClassicalShipDetector:
         colour: bool = True,
         max_candidates: int = 200,
         refine: Literal["mask", "flank"] = "mask",
-        censor: bool = False,
+        censor: bool = True,
     ) -> None:
         self.threshold = positive("threshold", threshold)
         self.grow_threshold = positive("grow_threshold", grow_threshold)
@@ -1075,11 +1077,12 @@ class ClassicalShipDetector:
         if not cands:
             return Detections.empty()
         tol = self.horizon_tolerance * H
-        hidden = (
-            self._censored(cands, levels[0], floor) if self.censor and not self.temporal else []
-        )
+        every = cands
         cands = [c for c in cands if self._near_sea(c, fr, mask, ends, tol)]
         cands = self._clutter_test(cands, levels[0])
+        hidden = []
+        if self.censor and not self.temporal and cands:
+            hidden = self._censored(every, cands, levels[0], floor)
         cands = self._merge(self._resolve_scales(cands))
         # a target found beside a candidate is another object: merged only with its kind
         cands += self._merge([c for c in hidden if self._near_sea(c, fr, mask, ends, tol)])
@@ -1392,24 +1395,31 @@ class ClassicalShipDetector:
                 cands.append(_Candidate(box, k, float(peaks[i]), int(pols[i])))
         return cands
 
-    def _censored(self, cands: list[_Candidate], lv0: _Level, floor: float) -> list[_Candidate]:
-        """Step 4b: the targets that the candidates hid. Around every candidate the
-        finest scale is computed again with censored training windows and noise cells
-        (:func:`_censored_contrast_kernel`: the candidates' boxes, grown by a pixel, left
-        out), on the rows within a noise cell of them; components of the new statistic
+    def _censored(
+        self, cands: list[_Candidate], around: list[_Candidate], lv0: _Level, floor: float
+    ) -> list[_Candidate]:
+        """Step 4b: the targets that the candidates hid. Around each candidate that passed
+        the clutter test (``around``) the finest scale is computed again with censored
+        training windows and noise cells (:func:`_censored_contrast_kernel`: the boxes
+        of all ``cands``, grown by a pixel, left out), within a noise cell's rows and
+        the windows' or a cell's reach in columns of it; components of the new statistic
         that hold a seed and stay ``_CENSOR_GAP`` px clear of every candidate are new
         candidates (also through the clutter-map test, on the censored statistic), with
         these maps for their refinement. Measured (session 23, rendered lighting case,
         frame 50): the 7 × 2 px boat 18 px left of the ferry had ``z`` = 2.4 — the
         ferry in its right window and in its noise cell (σ 15 against the sea's 4–6) —,
-        and 10.6 with both censored. Over the 24 rendered clips (8 cases × 3 renderings)
-        the lighting boat is then tracked in 445 of its 600 frames instead of 321 and
-        crossing's sailboat in 576 instead of 418; the other six cases are unchanged to
-        the last digit, unmatched boxes 1,198 → 1,251 (lighting's glint 957 → 983).
-        Off by default until the project's records are measured with it: the CLE rises
-        with the hard frames it adds (lighting 2.59 → 3.04 %, the boat's cabin is
-        invisible in the glare; crossing 6.76 → 6.76 %), and on a long hull it finds the
-        end that the CFAR's own shadow cut off as a box of its own."""
+        and 10.6 with both censored. Over the 24 rendered clips (8 cases × 3 renderings,
+        session 22's horizons): the lighting boat is tracked in 407 of its 600 frames
+        instead of 321 and crossing's sailboat in 576 instead of 418; the other six cases
+        are unchanged to the last digit; boxes on no ship 1,198 → 1,200. The CLE rises
+        with the hard frames it adds (lighting 2.59 → 2.92 %: the boat's white cabin is
+        invisible in the glare; crossing 6.76 → 6.77 %). With a 3-px clearance beside a
+        candidate too (instead of ``guard``), it boxed the end of a long hull that the
+        CFAR's own shadow cut off as a ship of its own, and glint beside glint (boxes on
+        no ship 1,251); merged with the other candidates, crossing's container ship took
+        the ferry's fragments (seed 2: 14.0 → 18.7 %). Cost on the 1080p benchmark clip:
+        about 1.7 ms a frame, 7 % of the detection (the passed candidates' neighbourhoods
+        only)."""
         if not cands:
             return []
         gs = self._buffers.get(("gy1", lv0.z.shape, np.dtype(np.float32).str))
@@ -1419,35 +1429,40 @@ class ClassicalShipDetector:
         H, W = gs.shape
         guard, flank = lv0.window
         keep = np.ones((H, W), np.uint8)
-        clear = np.ones((H, W), np.uint8)  # where a new component may lie
-        g = _CENSOR_GAP
-        spans = []
+        reach = max(guard + flank, self.cell[1])  # windows and noise cells it reaches
         for c in cands:
             x0, y0, x1, y1 = (int(v) for v in c.box)
             keep[max(0, y0 - 1) : y1 + 2, max(0, x0 - 1) : x1 + 2] = 0
-            clear[max(0, y0 - g) : y1 + g + 1, max(0, x0 - g) : x1 + g + 1] = 0
-            spans.append((max(0, y0 - self.cell[0]), min(H, y1 + self.cell[0] + 1)))
-        spans.sort()
-        merged = [list(spans[0])]
-        for a, b in spans[1:]:
-            if a <= merged[-1][1]:
-                merged[-1][1] = max(merged[-1][1], b)
-            else:
-                merged.append([a, b])
+        rects = []
+        for c in around:
+            x0, y0, x1, y1 = (int(v) for v in c.box)
+            rects.append(
+                [
+                    max(0, y0 - self.cell[0]),
+                    min(H, y1 + self.cell[0] + 1),
+                    max(0, x0 - reach),
+                    min(W, x1 + reach + 1),
+                ]
+            )
+        # a new component must stay clear of every candidate: _CENSOR_GAP rows above
+        # and below, ``guard`` columns beside (nearer on the same rows it is the end of
+        # the candidate's hull that the CFAR's own shadow cut off)
+        old = np.array([c.box for c in cands])
+        near = old + np.array([-guard, -_CENSOR_GAP, guard, _CENSOR_GAP], float)
         pol = {"both": 0, "bright": 1, "dark": 2}[self.polarity]
         max_w, max_h = self.max_size * W + 1, self.max_size * H + 1
         wide, tall = self.max_aspect
         maps: _Level | None = None
         out: list[_Candidate] = []
-        for r0, r1 in merged:
-            n = r1 - r0
-            hi, lo, d, c, tex = (np.empty((n, W), np.float32) for _ in range(5))
+        for r0, r1, c0, c1 in _union_rects(rects):
+            n, m = r1 - r0, c1 - c0
+            hi, lo, d, c, tex = (np.empty((n, m), np.float32) for _ in range(5))
             _censored_contrast_kernel(
-                gs, b5, keep, r0, r1, guard, flank, pol, 1.5 * flank, hi, lo, d, c, tex
+                gs, b5, keep, r0, r1, c0, c1, guard, flank, pol, 1.5 * flank, hi, lo, d, c, tex
             )
             sigma = np.maximum(_cell_noise(d, self.cell[0], self.cell[1], floor), tex)
             z = np.divide(c, sigma, out=c)
-            z *= clear[r0:r1]
+            z *= keep[r0:r1, c0:c1]  # a candidate's own pixels join no component
             sign = _NO_SIGN
             if pol == 0:
                 sign = (d <= 0).view(np.uint8) + np.uint8(1)
@@ -1457,12 +1472,34 @@ class ClassicalShipDetector:
                 np.float32(self.threshold),
                 self.border,
                 np.float32(self.grow_threshold),
-                np.zeros(n * W, np.uint8),
-                np.empty(n * W, np.int64),
+                np.zeros(n * m, np.uint8),
+                np.empty(n * m, np.int64),
             )
             if boxes.shape[0] == 0:
                 continue
-            if maps is None:
+            ii = cv2.integral((z > self.grow_threshold).view(np.uint8))
+            found = []
+            for i in range(boxes.shape[0]):
+                x0, y0, x1, y1 = (int(v) for v in boxes[i])
+                w, h = x1 - x0 + 1, y1 - y0 + 1
+                if w > max_w or h > max_h or w > wide * h + 1 or h > tall * w + 1:
+                    continue
+                box = np.array([x0, y0, x1, y1], float)
+                shifted = box + np.array([c0, r0, c0, r0], float)
+                if (
+                    (near[:, 0] <= shifted[2])
+                    & (shifted[0] <= near[:, 2])
+                    & (near[:, 1] <= shifted[3])
+                    & (shifted[1] <= near[:, 3])
+                ).any():
+                    continue
+                cand = _Candidate(box, 0, float(peaks[i]), int(pols[i]))
+                if self._clutter_pass(cand, ii, z.shape):
+                    cand.box = shifted
+                    found.append(cand)
+            if not found:
+                continue
+            if maps is None:  # the finest scale's maps, censored where a target was found
                 maps = _Level(
                     1,
                     lv0.bg_bright.copy(),
@@ -1473,23 +1510,15 @@ class ClassicalShipDetector:
                     lv0.sign.copy(),
                     lv0.window,
                 )
-            maps.bg_bright[r0:r1] = hi
-            maps.bg_dark[r0:r1] = lo
-            maps.sigma[r0:r1] = sigma
-            maps.z[r0:r1] = z
+            maps.bg_bright[r0:r1, c0:c1] = hi
+            maps.bg_dark[r0:r1, c0:c1] = lo
+            maps.sigma[r0:r1, c0:c1] = sigma
+            maps.z[r0:r1, c0:c1] = z
             if pol == 0:
-                maps.sign[r0:r1] = sign
-            ii = cv2.integral((z > self.grow_threshold).view(np.uint8))
-            for i in range(boxes.shape[0]):
-                x0, y0, x1, y1 = (int(v) for v in boxes[i])
-                w, h = x1 - x0 + 1, y1 - y0 + 1
-                if w > max_w or h > max_h or w > wide * h + 1 or h > tall * w + 1:
-                    continue
-                box = np.array([x0, y0, x1, y1], float)
-                cand = _Candidate(box, 0, float(peaks[i]), int(pols[i]), maps)
-                if self._clutter_pass(cand, ii, z.shape):
-                    box[[1, 3]] += r0
-                    out.append(cand)
+                maps.sign[r0:r1, c0:c1] = sign
+            for cand in found:
+                cand.maps = maps
+            out += found
         return out
 
     def _clutter_test(self, cands: list[_Candidate], lv0: _Level) -> list[_Candidate]:
@@ -2082,6 +2111,26 @@ class ClassicalShipDetector:
         gx1, gy1 = min(W, X1 + 1), min(H, Y1 + 1)
         inner = (slice(Y0 - gy0, Y1 - gy0), slice(X0 - gx0, X1 - gx0))
         return np.maximum(_chroma_contrast(fr, lv, (gx0, gy0, gx1, gy1), inner, mx, my), 0.0)
+
+
+def _union_rects(rects: list[list[int]]) -> list[list[int]]:
+    """Rectangles ``[r0, r1, c0, c1]`` (half-open) merged until none overlap: each result
+    is the bounding rectangle of a group of overlapping ones."""
+    out = [list(r) for r in rects]
+    merged = True
+    while merged:
+        merged = False
+        for i in range(len(out)):
+            for j in range(i + 1, len(out)):
+                a, b = out[i], out[j]
+                if a[0] < b[1] and b[0] < a[1] and a[2] < b[3] and b[2] < a[3]:
+                    out[i] = [min(a[0], b[0]), max(a[1], b[1]), min(a[2], b[2]), max(a[3], b[3])]
+                    del out[j]
+                    merged = True
+                    break
+            if merged:
+                break
+    return out
 
 
 def _joined(mask: NDArray[np.bool_], core: tuple[int, int, int, int]) -> NDArray[np.bool_] | None:
