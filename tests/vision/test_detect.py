@@ -34,6 +34,7 @@ from seawatch.vision.detect import (
     waterline_points,
 )
 from seawatch.vision.detect import _trim_other_polarity as trim_other_polarity
+from seawatch.vision.detect import _union_rects as union_rects
 from seawatch.vision.external import (
     CallableDetector,
     MaskedDetector,
@@ -1380,3 +1381,30 @@ def test_censoring_changes_nothing_where_nothing_is_hidden():
         censored = ClassicalShipDetector(censor=True)(as_u8(img), horizon=line).boxes
         assert plain.shape[0] >= 4
         np.testing.assert_array_equal(censored, plain)
+
+
+@settings(max_examples=200, deadline=None, derandomize=True)
+@given(
+    st.lists(
+        st.tuples(st.integers(0, 60), st.integers(1, 20), st.integers(0, 60), st.integers(1, 20)),
+        min_size=1,
+        max_size=12,
+    )
+)
+def test_union_rects_covers_every_rectangle_with_disjoint_ones(spec):
+    """The censored pass's regions: every given rectangle lies inside one result, the
+    results overlap nowhere, and each result is the bounding box of given ones."""
+    rects = [[r, r + h, c, c + w] for r, h, c, w in spec]
+    out = union_rects(rects)
+
+    def within(a, b):
+        return b[0] <= a[0] and a[1] <= b[1] and b[2] <= a[2] and a[3] <= b[3]
+
+    for a in rects:
+        assert any(within(a, b) for b in out)
+    for i, a in enumerate(out):
+        for b in out[i + 1 :]:
+            assert not (a[0] < b[1] and b[0] < a[1] and a[2] < b[3] and b[2] < a[3])
+        inside = [r for r in rects if within(r, a)]
+        assert [min(r[0] for r in inside), max(r[1] for r in inside)] == a[:2]
+        assert [min(r[2] for r in inside), max(r[3] for r in inside)] == a[2:]

@@ -1402,10 +1402,11 @@ class ClassicalShipDetector:
         the clutter test (``around``) the finest scale is computed again with censored
         training windows and noise cells (:func:`_censored_contrast_kernel`: the boxes
         of all ``cands``, grown by a pixel, left out), within a noise cell's rows and
-        the windows' or a cell's reach in columns of it; components of the new statistic
-        that hold a seed and stay ``_CENSOR_GAP`` px clear of every candidate are new
-        candidates (also through the clutter-map test, on the censored statistic), with
-        these maps for their refinement. Measured (session 23, rendered lighting case,
+        the windows' or a cell's reach in columns of it (luma only); components of the
+        new statistic that hold a seed and stay clear of every candidate (``_CENSOR_GAP``
+        rows above or below, ``guard`` columns beside) are new candidates (also through
+        the clutter-map test, on the censored statistic), with these maps for their
+        refinement. Measured (session 23, rendered lighting case,
         frame 50): the 7 × 2 px boat 18 px left of the ferry had ``z`` = 2.4 — the
         ferry in its right window and in its noise cell (σ 15 against the sea's 4–6) —,
         and 10.6 with both censored. Over the 24 rendered clips (8 cases × 3 renderings,
@@ -1422,6 +1423,7 @@ class ClassicalShipDetector:
         only)."""
         if not cands:
             return []
+        # the finest scale's smoothed plane and its 5 × 5 mean, as _contrast left them
         gs = self._buffers.get(("gy1", lv0.z.shape, np.dtype(np.float32).str))
         b5 = self._buffers.get(("by1", lv0.z.shape, np.dtype(np.float32).str))
         if gs is None or b5 is None:
