@@ -31,7 +31,7 @@ Colour frames are taken in OpenCV's BGR(A) order; grey frames may be 8-bit, 16-b
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal, Protocol, runtime_checkable
 
 import cv2
@@ -250,6 +250,23 @@ def sea_region(shape: tuple[int, int], horizon: Any) -> NDArray[np.bool_]:
 # --------------------------------------------------------------------------------------
 
 
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _cfar_pixel(g, L, R, EL, ER, polarity):  # pragma: no cover - compiled
+    """One pixel's outputs of the contrast kernels from its value ``g`` and its training
+    windows' means ``L``, ``R`` and detail ``EL``, ``ER``: ``(max(L, R), min(L, R),
+    g − (L + R)/2, sqrt(min(EL, ER)), c)`` with ``c`` by ``polarity`` (1 bright, 2 dark,
+    0 the larger)."""
+    h = max(L, R)
+    lw = min(L, R)
+    if polarity == 1:
+        c = g - h
+    elif polarity == 2:
+        c = lw - g
+    else:
+        c = max(g - h, lw - g)
+    return h, lw, g - 0.5 * (L + R), np.sqrt(max(0.0, min(EL, ER))), c
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def _contrast_kernel(  # pragma: no cover - compiled
     gs, b5, guard, flank, polarity, hi, lo, d, c, tex
@@ -334,19 +351,9 @@ def _contrast_kernel(  # pragma: no cover - compiled
         cr = c[r]
         tr = tex[r]
         for j in range(W):
-            g = np.float64(g1[j])
-            h = max(L[j], R[j])
-            lw = min(L[j], R[j])
-            hr[j] = h
-            lr[j] = lw
-            dr[j] = g - 0.5 * (L[j] + R[j])
-            tr[j] = np.sqrt(max(0.0, min(EL[j], ER[j])))
-            if polarity == 1:
-                cr[j] = g - h
-            elif polarity == 2:
-                cr[j] = lw - g
-            else:
-                cr[j] = max(g - h, lw - g)
+            hr[j], lr[j], dr[j], tr[j], cr[j] = _cfar_pixel(
+                np.float64(g1[j]), L[j], R[j], EL[j], ER[j], polarity
+            )
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -408,18 +415,7 @@ def _censored_contrast_kernel(  # pragma: no cover - compiled
             if not okl:
                 L = R
                 EL = ER
-            h = max(L, R)
-            lw = min(L, R)
-            hi[o, k] = h
-            lo[o, k] = lw
-            d[o, k] = g - 0.5 * (L + R)
-            tex[o, k] = np.sqrt(max(0.0, min(EL, ER)))
-            if polarity == 1:
-                c[o, k] = g - h
-            elif polarity == 2:
-                c[o, k] = lw - g
-            else:
-                c[o, k] = max(g - h, lw - g)
+            hi[o, k], lo[o, k], d[o, k], tex[o, k], c[o, k] = _cfar_pixel(g, L, R, EL, ER, polarity)
 
 
 @njit(cache=True, nogil=True)
@@ -715,6 +711,8 @@ class PreparedFrame:
 
 
 _NO_SIGN = np.full((1, 1), 3, np.uint8)  # one polarity only: every pixel joins
+
+_POLARITY_CODE = {"both": 0, "bright": 1, "dark": 2}  # the contrast kernels' ``polarity``
 
 _CENSOR_GAP = 3
 """Least gap [working px] above or below a candidate to a target found with censored
@@ -1270,7 +1268,7 @@ class ClassicalShipDetector:
         at the finest scale of a colour frame the chroma planes' statistics join in
         (``z = max(z_Y, z_Cr, z_Cb)``), so that a boat of the sea's brightness but not its
         colour is found."""
-        pol = {"both": 0, "bright": 1, "dark": 2}[self.polarity]
+        pol = _POLARITY_CODE[self.polarity]
         gs, hi, lo, d, c, sigma = self._contrast(g, f"y{factor}", factor, floor, guard, flank, pol)
         if self.temporal:
             c, sigma = self._apply_temporal(gs, hi, lo, d, sigma, fr, factor)
@@ -1366,8 +1364,6 @@ class ClassicalShipDetector:
         ignored (vignetting, dead columns), and components too large or too elongated for
         a ship are dropped."""
         cands: list[_Candidate] = []
-        max_w, max_h = self.max_size * shape[1], self.max_size * shape[0]
-        wide, tall = self.max_aspect
         for k, lv in enumerate(levels):
             z = lv.z
             f = lv.factor
@@ -1388,7 +1384,7 @@ class ClassicalShipDetector:
                 continue
             w = (boxes[:, 2] - boxes[:, 0] + 1) * f
             h = (boxes[:, 3] - boxes[:, 1] + 1) * f
-            ok = (w <= max_w + f) & (h <= max_h + f) & (w <= wide * h + f) & (h <= tall * w + f)
+            ok = self._ship_shaped(w, h, shape, f)
             for i in np.flatnonzero(ok)[np.argsort(-peaks[ok])][: self.max_candidates]:
                 x0, y0, x1, y1 = boxes[i]
                 box = np.array([x0 * f, y0 * f, (x1 + 1) * f - 1, (y1 + 1) * f - 1], float)
@@ -1451,9 +1447,7 @@ class ClassicalShipDetector:
         # the candidate's hull that the CFAR's own shadow cut off)
         old = np.array([c.box for c in cands])
         near = old + np.array([-guard, -_CENSOR_GAP, guard, _CENSOR_GAP], float)
-        pol = {"both": 0, "bright": 1, "dark": 2}[self.polarity]
-        max_w, max_h = self.max_size * W + 1, self.max_size * H + 1
-        wide, tall = self.max_aspect
+        pol = _POLARITY_CODE[self.polarity]
         maps: _Level | None = None
         out: list[_Candidate] = []
         for r0, r1, c0, c1 in _union_rects(rects):
@@ -1481,12 +1475,9 @@ class ClassicalShipDetector:
                 continue
             ii = cv2.integral((z > self.grow_threshold).view(np.uint8))
             found = []
-            for i in range(boxes.shape[0]):
-                x0, y0, x1, y1 = (int(v) for v in boxes[i])
-                w, h = x1 - x0 + 1, y1 - y0 + 1
-                if w > max_w or h > max_h or w > wide * h + 1 or h > tall * w + 1:
-                    continue
-                box = np.array([x0, y0, x1, y1], float)
+            w, h = boxes[:, 2] - boxes[:, 0] + 1, boxes[:, 3] - boxes[:, 1] + 1
+            for i in np.flatnonzero(self._ship_shaped(w, h, (H, W), 1)):
+                box = boxes[i].astype(float)
                 shifted = box + np.array([c0, r0, c0, r0], float)
                 if (
                     (near[:, 0] <= shifted[2])
@@ -1502,15 +1493,13 @@ class ClassicalShipDetector:
             if not found:
                 continue
             if maps is None:  # the finest scale's maps, censored where a target was found
-                maps = _Level(
-                    1,
-                    lv0.bg_bright.copy(),
-                    lv0.bg_dark.copy(),
-                    lv0.sigma.copy(),
-                    lv0.z.copy(),
-                    lv0.chroma,
-                    lv0.sign.copy(),
-                    lv0.window,
+                maps = replace(
+                    lv0,
+                    bg_bright=lv0.bg_bright.copy(),
+                    bg_dark=lv0.bg_dark.copy(),
+                    sigma=lv0.sigma.copy(),
+                    z=lv0.z.copy(),
+                    sign=lv0.sign.copy(),
                 )
             maps.bg_bright[r0:r1, c0:c1] = hi
             maps.bg_dark[r0:r1, c0:c1] = lo
@@ -1522,6 +1511,20 @@ class ClassicalShipDetector:
                 cand.maps = maps
             out += found
         return out
+
+    def _ship_shaped(
+        self, w: NDArray, h: NDArray, shape: tuple[int, int], f: int
+    ) -> NDArray[np.bool_]:
+        """Which components of ``w × h`` working pixels (found at scale ``f``) a ship may
+        be: at most ``max_size`` of the band ``shape`` and within ``max_aspect``, with a
+        level pixel of slack."""
+        wide, tall = self.max_aspect
+        return (
+            (w <= self.max_size * shape[1] + f)
+            & (h <= self.max_size * shape[0] + f)
+            & (w <= wide * h + f)
+            & (h <= tall * w + f)
+        )
 
     def _clutter_test(self, cands: list[_Candidate], lv0: _Level) -> list[_Candidate]:
         """Clutter-map threshold: with ``ρ`` the fraction of finest-scale pixels with
