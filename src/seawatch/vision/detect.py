@@ -735,6 +735,7 @@ class _Level:
     sign: NDArray = field(default_factory=lambda: _NO_SIGN)  # polarity bits per pixel
     # (1 bright, 2 dark, 3 either)
     window: tuple[int, int] = (0, 0)  # the CFAR's (guard, flank) at this scale [px]
+    planes: tuple[NDArray, NDArray] | None = None  # smoothed plane g and its 5 × 5 mean
 
 
 @dataclass
@@ -1237,9 +1238,10 @@ class ClassicalShipDetector:
 
     def _contrast(
         self, g: NDArray, tag: str, factor: int, floor: float, guard: int, flank: int, pol: int
-    ) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray, NDArray]:
-        """Smoothed plane, CFAR backgrounds, signed contrast ``d``, contrast ``c`` and noise
-        ``σ`` of one plane at one scale (class docstring, steps 2–3)."""
+    ) -> tuple[tuple[NDArray, NDArray], NDArray, NDArray, NDArray, NDArray, NDArray]:
+        """Smoothed plane and its 5 × 5 mean, CFAR backgrounds, signed contrast ``d``,
+        contrast ``c`` and noise ``σ`` of one plane at one scale (class docstring, steps
+        2–3)."""
         shape = g.shape
         gs = cv2.GaussianBlur(
             g, (3, 3), 0.8, dst=self._buffer(f"g{tag}", shape), borderType=cv2.BORDER_REPLICATE
@@ -1253,7 +1255,7 @@ class ClassicalShipDetector:
             ch, cw = max(4, self.cell[0] // 2), max(16, shape[1] // 4)
             base = _cell_noise(d, ch, cw, floor, step=1, quantile=0.3)
         sigma = np.maximum(base, tex, out=tex)
-        return gs, hi, lo, d, c, sigma
+        return (gs, b5), hi, lo, d, c, sigma
 
     def _level(
         self,
@@ -1269,7 +1271,10 @@ class ClassicalShipDetector:
         (``z = max(z_Y, z_Cr, z_Cb)``), so that a boat of the sea's brightness but not its
         colour is found."""
         pol = _POLARITY_CODE[self.polarity]
-        gs, hi, lo, d, c, sigma = self._contrast(g, f"y{factor}", factor, floor, guard, flank, pol)
+        planes, hi, lo, d, c, sigma = self._contrast(
+            g, f"y{factor}", factor, floor, guard, flank, pol
+        )
+        gs = planes[0]
         if self.temporal:
             c, sigma = self._apply_temporal(gs, hi, lo, d, sigma, fr, factor)
         z = np.divide(c, sigma, out=c)
@@ -1293,7 +1298,7 @@ class ClassicalShipDetector:
                     np.putmask(sign, zc > z, 3)
                 np.maximum(z, zc, out=z)
                 chroma.append((ch_index, hc, lc, sc))
-        return _Level(factor, hi, lo, sigma, z, chroma, sign, (guard, flank))
+        return _Level(factor, hi, lo, sigma, z, chroma, sign, (guard, flank), planes)
 
     def _apply_temporal(
         self,
@@ -1406,27 +1411,25 @@ class ClassicalShipDetector:
         frame 50): the 7 × 2 px boat 18 px left of the ferry had ``z`` = 2.4 — the
         ferry in its right window and in its noise cell (σ 15 against the sea's 4–6) —,
         and 10.6 with both censored. Over the 24 rendered clips (8 cases × 3 renderings,
-        session 22's horizons): the lighting boat is tracked in 407 of its 600 frames
+        session 22's horizons): the lighting boat is tracked in 408 of its 600 frames
         instead of 321 and crossing's sailboat in 576 instead of 418; the other six cases
         are unchanged to the last digit; boxes on no ship 1,198 → 1,200. The CLE rises
-        with the hard frames it adds (lighting 2.59 → 2.92 %: the boat's white cabin is
-        invisible in the glare; crossing 6.76 → 6.77 %). With a 3-px clearance beside a
+        with the hard frames it adds (lighting 2.59 → 2.93 %: the boat's white cabin is
+        invisible in the glare; crossing 6.76 → 6.79 %). With a 3-px clearance beside a
         candidate too (instead of ``guard``), it boxed the end of a long hull that the
         CFAR's own shadow cut off as a ship of its own, and glint beside glint (boxes on
         no ship 1,251); merged with the other candidates, crossing's container ship took
         the ferry's fragments (seed 2: 14.0 → 18.7 %). Cost on the 1080p benchmark clip:
         about 1.7 ms a frame, 7 % of the detection (the passed candidates' neighbourhoods
         only)."""
-        if not cands:
+        if not cands or lv0.planes is None:
             return []
-        # the finest scale's smoothed plane and its 5 × 5 mean, as _contrast left them
-        gs = self._buffers.get(("gy1", lv0.z.shape, np.dtype(np.float32).str))
-        b5 = self._buffers.get(("by1", lv0.z.shape, np.dtype(np.float32).str))
-        if gs is None or b5 is None:
-            return []
+        # the level's own planes: the work buffers may have been dropped since (_work)
+        gs, b5 = lv0.planes
         H, W = gs.shape
         guard, flank = lv0.window
-        keep = np.ones((H, W), np.uint8)
+        keep = self._work("keep", (H, W), np.uint8)
+        keep.fill(1)
         reach = max(guard + flank, self.cell[1])  # windows and noise cells it reaches
         for c in cands:
             x0, y0, x1, y1 = (int(v) for v in c.box)
