@@ -1124,6 +1124,10 @@ def _prepare(arr: np.ndarray, work_width: int) -> tuple[np.ndarray, np.ndarray, 
     return luma, colour, W / w, H / h
 
 
+_MIN_CONFIDENCE = 0.3  # default confidence for ``found`` (detect_horizon; the tracker's
+# weak-detection floor is a fraction of it)
+
+
 def detect_horizon(
     image: ArrayLike,
     *,
@@ -1132,7 +1136,7 @@ def detect_horizon(
     max_tilt_deg: float = 25.0,
     work_width: int = 256,
     n_candidates: int = 6,
-    min_confidence: float = 0.3,
+    min_confidence: float = _MIN_CONFIDENCE,
     prior_sigma: float | None = None,
 ) -> HorizonEstimate:
     """Detect the sea horizon in one image (module docstring: method and scores).
@@ -1605,7 +1609,7 @@ class HorizonTracker:
         self._time = None if time is None else float(time)
         accepted = False
         self.last_nis = math.nan
-        floor = _WEAK_FRACTION * float(self.detector.get("min_confidence", 0.3))
+        floor = _WEAK_FRACTION * float(self.detector.get("min_confidence", _MIN_CONFIDENCE))
         if detection.found or detection.confidence >= floor:
             x, P = self._kf.x, self._kf.P
             nu = z - x[:2]
