@@ -478,6 +478,26 @@ def test_track_reconnects_a_dropped_stream_and_keeps_the_ship(clip, tmp_path, st
     assert _track_ids(rows, range(resumed)) & _track_ids(rows, range(resumed, 10**6))
 
 
+def test_track_keep_up_drops_frames_it_is_behind_on_and_a_file_loses_none(clip, tmp_path):
+    """``--keep-up`` on a file, which is decoded far faster than it is tracked (as a
+    camera that sends frames faster than the job keeps up with): frames are dropped,
+    counted and noted, the ship keeps one track across the gaps, and only the frames
+    tracked have rows. Without it a file loses no frame (the default off a real-time
+    source)."""
+    args = ["track", str(clip / "video.mp4"), "--keep-up", "--out", str(tmp_path / "out")]
+    res = runner.invoke(app, [*args, "--no-video", "--no-report", "--json"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout[res.stdout.index("{") :])
+    assert doc["frames_dropped"] > 0 and doc["frames"] + doc["frames_dropped"] == 80
+    assert any("dropped to keep up" in w for w in doc["warnings"])
+    rows = _rows(tmp_path / "out" / "tracks.csv")
+    assert len({int(r["frame"]) for r in rows}) <= doc["frames"]
+    assert len(_track_ids(rows, range(80))) == 1
+    run = track_video(clip / "video.mp4", tmp_path / "all", annotate=False, report=False)
+    assert run.frames == 80 and run.frames_dropped == 0
+    assert run.to_json()["frames_dropped"] == 0
+
+
 def test_a_resolution_change_scales_the_camera_and_restarts_the_tracks(clip, tmp_path):
     """A camera file calibrated at 1920×1080 on a 960×540 stream that drops to 640×360 at
     frame 40: the intrinsics are scaled to each size (warnings say so), the visual tracks

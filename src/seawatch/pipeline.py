@@ -166,6 +166,7 @@ class TrackRun:
         errors: with a truth file, the INTERFACES.md ``errors`` object (and details).
         ais: with AIS, the cross-check (matches, dark, unseen), else None.
         interrupted: the run stopped early (Ctrl-C, a signal, a stream that ended).
+        frames_dropped: frames of a live source dropped to keep up with it (``keep_up``).
     """
 
     frames: int
@@ -176,11 +177,13 @@ class TrackRun:
     errors: dict[str, Any] | None = None
     ais: dict[str, Any] | None = None
     interrupted: bool = False
+    frames_dropped: int = 0
 
     def to_json(self) -> dict[str, Any]:
         """The ``--json`` summary of ``seawatch track``."""
         doc: dict[str, Any] = {
             "frames": self.frames,
+            "frames_dropped": self.frames_dropped,
             "rows": self.rows,
             "tracks": self.tracks,
             "outputs": [str(p) for p in self.outputs],
@@ -424,6 +427,7 @@ def track_video(
     end: float | None = None,
     fps: float | None = None,
     reconnect: int = 0,
+    keep_up: bool | None = None,
     sigma_px: float = PIXEL_SIGMA,
     annotate: bool = True,
     report: bool = True,
@@ -463,6 +467,12 @@ def track_video(
         reconnect: attempts to reopen a live source that drops (:class:`VideoReader`);
             frames more than ``max(COAST_SECONDS, 3 step / fps)`` apart (a reconnection, a
             gap in a recording) restart the visual tracks with new ids.
+        keep_up: drop frames when the job falls behind a source that does not wait, so
+            that its outputs stay a few frames behind the source instead of ever further
+            (:meth:`~seawatch.vision.tracker.VisualTracker.stream`; the tracks coast over
+            the frames dropped, which are counted in ``frames_dropped``); None (default):
+            for a source that sends frames in real time (a camera device, an RTSP, RTMP,
+            UDP … stream), not for a file, a folder or an HTTP URL.
         sigma_px: 1-σ of the water-line pixel [px].
         annotate, report, parquet: write ``annotated.mp4``, ``report.html``,
             ``tracks.parquet``.
@@ -579,7 +589,7 @@ def track_video(
     interrupted = False
     # the next frames are decoded in one thread and their horizons and ships found in
     # another (VisualTracker.stream) while this one is tracked and written
-    frames_ahead = vtracker.stream(reader)
+    frames_ahead = vtracker.stream(reader, keep_up=keep_up)
     size: tuple[int, int] | None = None
     last_time: float | None = None
 
@@ -741,8 +751,14 @@ def track_video(
             min_truth_height=MIN_TRUTH_PX,
             frames=done,  # a frame skipped by --step or --max-frames is no miss
         ).to_json()
+    if vtracker.frames_dropped:
+        notes.append(
+            f"{vtracker.frames_dropped} frame(s) dropped to keep up with the source "
+            "(their tracks coasted)"
+        )
     run = TrackRun(
         frames=len(done),
+        frames_dropped=vtracker.frames_dropped,
         rows=tracks_out.rows,
         tracks=len(ids),
         outputs=outputs,

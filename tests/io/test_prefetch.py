@@ -51,3 +51,37 @@ def test_stopping_early_closes_the_source_in_the_background_thread():
 def test_bad_depth_raises_naming_it():
     with pytest.raises(ValueError, match="depth"):
         prefetch([1], depth=0)
+
+
+def test_skip_drops_what_arrives_while_the_consumer_is_behind():
+    """A source that does not wait (a live camera): with ``skip`` the thread drains it
+    while nobody consumes, keeps the first ``depth`` items and hands every later one to
+    ``skip`` (not to ``work``) instead of blocking."""
+    drained = threading.Event()
+    worked = []
+
+    def source():
+        yield from range(50)
+        drained.set()
+
+    def work(x):
+        worked.append(x)
+        return -x
+
+    skipped = []
+    it = prefetch(source(), depth=3, work=work, skip=skipped.append)
+    assert drained.wait(5.0)  # the source ran to its end with no consumer
+    assert list(it) == [0, -1, -2]
+    assert skipped == list(range(3, 50)) and worked == [0, 1, 2]
+
+
+def test_without_skip_a_consumer_behind_blocks_the_source_and_loses_nothing():
+    drained = threading.Event()
+
+    def source():
+        yield from range(50)
+        drained.set()
+
+    it = prefetch(source(), depth=3)
+    assert not drained.wait(0.3)  # held back by the full queue
+    assert list(it) == list(range(50))

@@ -572,3 +572,31 @@ def test_single_image_file_is_one_frame(tmp_path: Path):
     np.testing.assert_array_equal(read_image(path), _pattern(5))
     with pytest.raises(VideoError, match=r"missing\.png"):
         read_image(tmp_path / "missing.png")
+
+
+@pytest.mark.parametrize(
+    ("source", "realtime"),
+    [("rtsp://mast/stream", True), ("RTSP://mast/stream", True), ("udp://239.0.0.1:5000", True),
+     ("srt://cam:9000", True), ("rtmp://host/live", True), (0, True), ("/dev/video0", True),
+     ("http://host/clip.mp4", False), ("https://host/live.m3u8", False)],
+)  # fmt: skip
+def test_realtime_sources_are_cameras_and_streaming_protocols_not_http_or_files(source, realtime):
+    """Sources that send frames whether or not they are read (the track job drops frames
+    to keep up with them by default): camera devices and the streaming protocols; an
+    HTTP URL may be a file served as fast as it is read, and files and folders wait."""
+    from seawatch.io.video import _classify, _realtime
+
+    assert _realtime(_classify(source)[0], source) == realtime
+
+
+def test_an_http_stream_and_a_file_are_not_realtime(
+    transport_stream: bytes, stream_server: type, tmp_path
+):
+    with stream_server(transport_stream) as server:
+        reader = VideoReader(f"http://127.0.0.1:{server.port}/clip.ts", timeout=5.0)
+        assert reader.live and not reader.realtime
+        reader.close()
+    path = tmp_path / "clip.ts"
+    path.write_bytes(transport_stream)
+    with VideoReader(path) as reader:
+        assert not reader.live and not reader.realtime

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -225,6 +226,65 @@ def test_stream_stops_its_threads_and_closes_the_source_when_left_early():
             t.join(timeout=5)
     assert closed == [True]
     assert threading.active_count() == before
+
+
+class _Camera:
+    """A source that sends frames in real time: they come whether or not they are read."""
+
+    realtime = True
+
+    def __init__(self, n: int):
+        self.n = n
+        self.sent = threading.Event()
+
+    def __iter__(self):
+        from seawatch.io.video import Frame
+
+        for k in range(self.n):
+            yield Frame(k, k / 25.0, np.full((60, 80), 40 + k % 3, np.uint8))
+        self.sent.set()
+
+
+def test_stream_keeps_up_with_a_realtime_source_by_dropping_frames():
+    """A caller that falls behind a camera: the frames that come while three wait are
+    dropped before their horizon and detection (counted in ``frames_dropped``, a warning
+    names the first), the others come in order; without ``keep_up`` (the default for a
+    source without ``realtime``) every frame comes."""
+    camera = _Camera(40)
+    vt = VisualTracker(horizon=False)
+    with pytest.warns(UserWarning, match=r"frame \d+: processing is behind the source"):
+        stream = vt.stream(camera)
+        got = [next(stream)[0].index]
+        assert camera.sent.wait(10.0)  # the whole clip sent while the caller was busy
+        got += [fr.index for fr, _, _ in stream]
+    assert got == sorted(got) and got[0] == 0
+    assert vt.frames_dropped == 40 - len(got) >= 25  # at most 1 + 3 + 1 + 3 + 3 kept
+    slow = _Camera(40)
+    slow.realtime = False
+    vt = VisualTracker(horizon=False)
+    stream = vt.stream(slow)
+    got = [next(stream)[0].index]
+    assert not slow.sent.wait(0.3)
+    got += [fr.index for fr, _, _ in stream]
+    assert got == list(range(40)) and vt.frames_dropped == 0
+
+
+def test_frames_dropped_to_keep_up_are_coasted_over_by_index():
+    """The tracks coast over the frames dropped as over frames the source lost: a ship
+    seen at frames 0-9 and 20-29 (10-19 dropped) keeps its track and id."""
+
+    def box(k):
+        return np.array([[100.0 + 2 * k, 200.0, 40.0, 12.0]])
+
+    vt = VisualTracker(detector=lambda *a, **k: None, horizon=False)
+    ids = set()
+    for k in [*range(10), *range(20, 30)]:
+        vt.coast_to(k)
+        rows = vt.update(box(k))
+        ids |= set(rows[:, 0].astype(int))
+        if k == 20:
+            assert abs(rows[0, 1] + rows[0, 3] / 2 - (120.0 + 2 * k)) < 2.0
+    assert len(ids) == 1
 
 
 def test_stream_raises_a_detector_error_at_its_frame_after_the_frames_before():

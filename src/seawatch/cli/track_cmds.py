@@ -158,6 +158,17 @@ def track(
     end: EndOption = None,
     fps: FpsOption = None,
     reconnect: ReconnectOption = 0,
+    keep_up: Annotated[
+        bool | None,
+        typer.Option(
+            "--keep-up/--no-keep-up",
+            help="Drop frames when the job falls behind the source, so that it stays a few "
+            "frames behind instead of ever further (the tracks coast over them; counted in "
+            "the summary's frames_dropped). Default: on for a camera device or an RTSP, RTMP, "
+            "UDP, SRT stream, off for a file, folder or HTTP URL.",
+            show_default=False,
+        ),
+    ] = None,
     video: Annotated[bool, typer.Option(help="Write annotated.mp4.")] = True,
     report: Annotated[bool, typer.Option(help="Write report.html.")] = True,
     parquet: Annotated[bool, typer.Option(help="Also write tracks.parquet (pyarrow).")] = False,
@@ -224,6 +235,7 @@ def track(
                 end=end,
                 fps=fps,
                 reconnect=reconnect,
+                keep_up=keep_up,
                 annotate=video,
                 report=report,
                 parquet=parquet,
@@ -232,7 +244,12 @@ def track(
         if json_out:
             emit_json(result.to_json())
         else:
-            err.print(f"{result.frames} frames, {result.tracks} tracks, {result.rows} rows")
+            dropped = (
+                f" ({result.frames_dropped} dropped to keep up)" if result.frames_dropped else ""
+            )
+            err.print(
+                f"{result.frames} frames{dropped}, {result.tracks} tracks, {result.rows} rows"
+            )
             for line in error_summary(result.errors):
                 err.print(line)
             for path in result.outputs:

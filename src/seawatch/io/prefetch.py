@@ -25,6 +25,7 @@ def prefetch(
     depth: int = 3,
     work: Callable[[Any], T] | None = None,
     name: str = "seawatch-prefetch",
+    skip: Callable[[Any], None] | None = None,
 ) -> Iterator[T]:
     """Iterate ``items`` (each passed through ``work`` when given) in a background
     thread, at most ``depth`` items ahead of the consumer, in order.
@@ -39,6 +40,14 @@ def prefetch(
         depth: how many items may wait (>= 1).
         work: optional per-item function run in the background thread.
         name: the thread's name (``threading``; shown by profilers and the benchmark).
+        skip: keep up with a source that will not wait (a live camera): an item that
+            arrives while ``depth`` items already wait — the consumer is behind — is
+            handed to ``skip`` (to count it) instead of ``work`` and the queue. The
+            thread then never blocks on a slow consumer (an item worked on while the
+            queue filled still waits for its place), so the source is drained at its own
+            rate and the consumer stays at most about ``depth`` items behind it, where
+            a blocking queue leaves the backlog in the source (a live stream's socket
+            and decoder) to grow without bound. None (default): every item, in order.
 
     Raises:
         ValueError: ``depth`` < 1.
@@ -61,7 +70,12 @@ def prefetch(
         it = iter(items)
         try:
             for x in it:
-                if stop.is_set() or not put(_ITEM, work(x) if work is not None else x):
+                if stop.is_set():
+                    return
+                if skip is not None and q.full():
+                    skip(x)
+                    continue
+                if not put(_ITEM, work(x) if work is not None else x):
                     return
         except BaseException as exc:  # handed to the consumer, raised there
             put(_ERROR, exc)

@@ -111,6 +111,18 @@ IMAGE_EXTENSIONS = frozenset(
 
 SourceKind = Literal["file", "folder", "image", "url", "device"]
 
+REALTIME_SCHEMES = (
+    "rtsp://",
+    "rtsps://",
+    "rtmp://",
+    "rtmps://",
+    "rtp://",
+    "udp://",
+    "srt://",
+    "tcp://",
+)
+"""URL schemes of sources that send frames in real time (:attr:`VideoReader.realtime`)."""
+
 _URL = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*://")
 _MAX_WARNINGS = 10  # individual warnings per kind before they are summarised at the end
 _MAX_GAP_S = 10.0  # [s] longer forward timestamp jumps are discontinuities, not lost frames
@@ -204,6 +216,14 @@ def read_image(path: str | os.PathLike[str], *, gray: bool = False) -> NDArray[A
 # --------------------------------------------------------------------------------------
 # reader
 # --------------------------------------------------------------------------------------
+
+
+def _realtime(kind: SourceKind, source: object) -> bool:
+    """Whether a source of this kind sends its frames in real time (a camera device, a
+    URL of :data:`REALTIME_SCHEMES`)."""
+    if kind == "device":
+        return True
+    return kind == "url" and str(source).lower().startswith(REALTIME_SCHEMES)
 
 
 def _classify(source: object) -> tuple[SourceKind, str | int | Path]:
@@ -344,6 +364,14 @@ class VideoReader:
     def live(self) -> bool:
         """True for URLs and camera devices (no known length, may drop)."""
         return self.kind in ("url", "device")
+
+    @property
+    def realtime(self) -> bool:
+        """True for a source that sends its frames at their own rate whether or not they
+        are read (a camera device; an ``rtsp``, ``rtmp``, ``rtp``, ``udp``, ``srt`` or
+        ``tcp`` stream): a reader slower than it must drop frames to keep up. An HTTP
+        URL may be a file served as fast as it is read: not counted."""
+        return _realtime(self.kind, self.source)
 
     @property
     def size(self) -> tuple[int, int] | None:

@@ -50,6 +50,7 @@ px, px, px, px, frames]; ``x, y`` is the box's top-left corner.
 
 from __future__ import annotations
 
+import warnings
 from collections import deque
 from collections.abc import Iterable, Iterator, Sequence
 from typing import Any, Literal
@@ -309,6 +310,8 @@ class VisualTracker:
         self._offsets: dict[int, FloatArray] = {}
         self._frame = 0
         self._last_index: int | None = None  # source index of the last frame (coast_to)
+        self.frames_dropped = 0
+        """Frames :meth:`stream` dropped to keep up with a live source (its last call)."""
         self._restart_motion()
         self._horizon: Any = None
         self.last_horizon: Any = None
@@ -532,7 +535,7 @@ class VisualTracker:
         return self.update(detections)
 
     def stream(
-        self, frames: Iterable[Any], *, ahead: bool = True
+        self, frames: Iterable[Any], *, ahead: bool = True, keep_up: bool | None = None
     ) -> Iterator[tuple[Any, Any, FloatArray]]:
         """``(frame, horizon, detections)`` of each frame, in order (step 1: the
         :meth:`horizon` and :meth:`detect` of each frame; hand the detections to
@@ -550,12 +553,28 @@ class VisualTracker:
         off (``cv2.setNumThreads(1)``, restored after). Stopping the iteration early
         stops both threads and closes ``frames``.
 
+        A live source (a camera, a stream) does not wait for a caller that is slower than
+        its frame rate: with ``keep_up`` a frame that arrives while the caller is three
+        frames behind is dropped before its horizon and ships are looked for
+        (:func:`~seawatch.io.prefetch.prefetch`'s ``skip``), so that the frames given
+        stay a few frames behind the source instead of ever further (1080p on two
+        cores: about 21 frames/s for the track job against a 25 frames/s camera, a
+        second more behind every 6 s). The frames dropped are counted in
+        :attr:`frames_dropped` and are missing from the iteration like frames the
+        source lost: :meth:`coast_to` (or :meth:`track_frames`) coasts over them by
+        their indices; a warning says when the first is dropped.
+
         Args:
             frames: images (H, W[, C]) or :class:`seawatch.io.video.Frame` objects (their
                 ``time`` feeds the horizon tracker), e.g. a ``VideoReader``.
-            ahead: False: everything in the calling thread.
+            ahead: False: everything in the calling thread (nothing is dropped).
+            keep_up: drop frames to keep up (above); None (default): for a source that
+                sends frames in real time, one whose ``realtime`` attribute is true (a
+                ``VideoReader`` of a camera device or an RTSP, RTMP, UDP … stream), not
+                for a file, a folder or an HTTP URL, whose frames wait to be read.
         """
 
+        self.frames_dropped = 0
         prepare = getattr(self.detector, "prepare", None)
         finish = getattr(self.detector, "detect_prepared", None)
         split = callable(prepare) and callable(finish)
@@ -586,9 +605,27 @@ class VisualTracker:
         # (bench video, per-thread CPU); its calls run in the calling thread meanwhile
         threads = cv2.getNumThreads()
         cv2.setNumThreads(1)
+        if keep_up is None:
+            keep_up = bool(getattr(frames, "realtime", False))
+        late: dict[str, Any] = {"count": 0, "first": None}  # written by the read thread
+
+        def drop(fr: Any) -> None:
+            if late["first"] is None:
+                late["first"] = getattr(fr, "index", "?")
+            late["count"] += 1
+
         try:
-            ready = prefetch(frames, work=horizon, name=READ_THREAD)
-            yield from prefetch(ready, work=detect, name=DETECT_THREAD)
+            ready = prefetch(frames, work=horizon, name=READ_THREAD, skip=drop if keep_up else None)
+            for item in prefetch(ready, work=detect, name=DETECT_THREAD):
+                if late["count"] and not self.frames_dropped:
+                    warnings.warn(
+                        f"frame {late['first']}: processing is behind the source; frames "
+                        "are dropped to keep up with it (their tracks coast)",
+                        stacklevel=2,
+                    )
+                self.frames_dropped = late["count"]
+                yield item
+            self.frames_dropped = late["count"]
         finally:
             cv2.setNumThreads(threads)
 
