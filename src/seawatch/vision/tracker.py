@@ -558,8 +558,8 @@ class VisualTracker:
         frames behind is dropped before its horizon and ships are looked for
         (:func:`~seawatch.io.prefetch.prefetch`'s ``skip``), so that the frames given
         stay a few frames behind the source instead of ever further (1080p on two
-        cores: about 21 frames/s for the track job against a 25 frames/s camera, a
-        second more behind every 6 s). The frames dropped are counted in
+        cores: the track job at 21–24 frames/s against a 25 frames/s camera falls a
+        second further behind every 6–25 s). The frames dropped are counted in
         :attr:`frames_dropped` and are missing from the iteration like frames the
         source lost: :meth:`coast_to` (or :meth:`track_frames`) coasts over them by
         their indices; a warning says when the first is dropped.
