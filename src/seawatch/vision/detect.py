@@ -1482,12 +1482,7 @@ class ClassicalShipDetector:
             for i in np.flatnonzero(self._ship_shaped(w, h, (H, W), 1)):
                 box = boxes[i].astype(float)
                 shifted = box + np.array([c0, r0, c0, r0], float)
-                if (
-                    (near[:, 0] <= shifted[2])
-                    & (shifted[0] <= near[:, 2])
-                    & (near[:, 1] <= shifted[3])
-                    & (shifted[1] <= near[:, 3])
-                ).any():
+                if any(_overlap(b, shifted) for b in near):
                     continue
                 cand = _Candidate(box, 0, float(peaks[i]), int(pols[i]))
                 if self._clutter_pass(cand, ii, z.shape):
