@@ -260,3 +260,26 @@ def test_bad_inputs_exit_2_naming_the_input(tmp_path):
 def test_help_has_an_example():
     res = runner.invoke(app, ["--help"])
     assert res.exit_code == 0 and "Example" in res.output
+
+
+def test_keep_up_drops_the_frames_it_is_behind_on_and_counts_them(tmp_path):
+    """``--keep-up`` on a file, decoded far faster than ships are looked for in it (as a
+    camera sending frames faster than the command keeps up with): frames are dropped
+    unprocessed, counted in ``frames_dropped`` and warned about, and those processed
+    are the source's own frames in order. A file without the option loses none (the
+    default off a real-time source) and its JSON keeps the INTERFACES shape."""
+    from seawatch.io.video import VideoWriter
+
+    path = tmp_path / "clip.mp4"
+    with VideoWriter(path, fps=25.0, crf=10) as writer:
+        for k in range(60):
+            writer.write(scene(20 + k % 5, shift=k % 8)[0])
+    res = runner.invoke(app, [str(path), "--json", "--keep-up"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    index = [f["index"] for f in doc["frames"]]
+    assert doc["frames_dropped"] > 0 and len(index) + doc["frames_dropped"] == 60
+    assert index[:2] == [0, 1] and np.all(np.diff(index) > 0)
+    assert "dropped to keep up" in _msg(res)
+    plain = json.loads(runner.invoke(app, [str(path), "--json"]).stdout)
+    assert set(plain) == {"frames"} and len(plain["frames"]) == 60

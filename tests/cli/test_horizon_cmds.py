@@ -194,3 +194,22 @@ def test_record_uses_frame_file_and_nulls_for_not_found():
         "y1": None,
         "confidence": 0.1,
     }
+
+
+def test_keep_up_loses_no_frame_it_does_not_count(tmp_path: Path):
+    """``--keep-up`` on a file (read faster than it is processed): every frame is either
+    in the records, in source order, or counted in ``frames_dropped``; the lines found
+    are the drawn ones."""
+    path = tmp_path / "clip.mp4"
+    with VideoWriter(path, 25.0) as writer:
+        for k in range(40):
+            writer.write(scene(100.0 + k / 4, 120.0 - k / 4, seed=k))
+    result = runner.invoke(app, ["horizon", str(path), "--json", "--keep-up"])
+    assert result.exit_code == 0, result.output
+    doc = json.loads(result.stdout)
+    index = [f["index"] for f in doc["frames"]]
+    assert len(index) + doc["frames_dropped"] == 40 and np.all(np.diff(index) > 0)
+    for f in doc["frames"]:
+        k = f["index"]
+        assert f["found"] and abs(f["y0"] - (100.0 + k / 4)) < 2.0
+        assert abs(f["y1"] - (120.0 - k / 4)) < 2.0

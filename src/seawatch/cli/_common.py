@@ -11,10 +11,10 @@ import json
 import math
 import sys
 import warnings
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated, Any, TextIO
+from typing import Annotated, Any, NamedTuple, TextIO
 
 import numpy as np
 import typer
@@ -59,6 +59,22 @@ ReconnectOption = Annotated[
         min=0,
     ),
 ]
+KeepUpOption = Annotated[
+    bool | None,
+    typer.Option(
+        "--keep-up/--no-keep-up",
+        help="Drop frames when the command falls behind the source, so that it stays a few "
+        "frames behind instead of ever further (counted in the JSON's frames_dropped; "
+        "tracks coast over them). "
+        "Default: on for a camera device or an RTSP, RTMP, UDP, SRT stream, off for a "
+        "file, folder or HTTP URL.",
+        show_default=False,
+    ),
+]
+
+KEEP_UP_DEPTH = 3
+"""Frames that may wait for a keeping-up command before the next one is dropped (as in
+:meth:`seawatch.vision.tracker.VisualTracker.stream`)."""
 
 
 def open_reader(
@@ -168,6 +184,16 @@ def open_csv(output: Path | None, columns: Sequence[str]) -> tuple[TextIO | None
     return sink, writer
 
 
+class FrameRecords(NamedTuple):
+    """What :func:`frame_records` returns: the records of the frames processed, the
+    source's failure that ended the loop (None when it ran to the end) and the frames
+    dropped to keep up with a real-time source."""
+
+    records: list[dict[str, Any]]
+    failure: Exception | None
+    dropped: int
+
+
 def frame_records(
     reader: Any,
     label: str,
@@ -176,7 +202,8 @@ def frame_records(
     output: Path | None,
     columns: Sequence[str],
     csv_rows: Callable[[dict[str, Any]], list[list[str]]],
-) -> tuple[list[dict[str, Any]], Exception | None]:
+    keep_up: bool = False,
+) -> FrameRecords:
     """Run ``process(frame) -> record`` over a :class:`~seawatch.io.video.VideoReader`.
 
     Shared loop of the per-frame commands (``horizon``, ``detect``): a progress bar on
@@ -184,17 +211,44 @@ def frame_records(
     ``csv_rows(record)`` appended to ``output`` and flushed frame by frame. A source that
     fails mid-stream ends the loop and is returned as the failure with the frames before
     it kept; a failure before the first frame is raised (bad input).
+
+    With ``keep_up`` the frames are read in a background thread
+    (:func:`seawatch.io.prefetch.prefetch`) and one that arrives while
+    :data:`KEEP_UP_DEPTH` frames already wait is dropped unprocessed and counted: a
+    live camera does not wait for a command slower than its frame rate, and without
+    dropping the backlog (and the delay of every record) grows without bound. A warning
+    names the first frame dropped.
     """
     from seawatch.io.video import VideoError
 
     records: list[dict[str, Any]] = []
     failure: Exception | None = None
+    late: dict[str, Any] = {"count": 0, "first": None}  # written by the read thread
+
+    def drop(frame: Any) -> None:
+        if late["first"] is None:
+            late["first"] = getattr(frame, "index", "?")
+        late["count"] += 1
+
+    frames: Iterable[Any] = reader
+    if keep_up:
+        from seawatch.io.prefetch import prefetch
+
+        frames = prefetch(reader, depth=KEEP_UP_DEPTH, name="seawatch-read", skip=drop)
+    warned = False
     sink, writer = open_csv(output, columns)
     try:
         with progress_bar() as bar:
             task = bar.add_task(label, total=reader.expected_frames)
             try:
-                for frame in reader:
+                for frame in frames:
+                    if late["count"] and not warned:
+                        warnings.warn(
+                            f"frame {late['first']}: processing is behind the source; "
+                            "frames are dropped to keep up with it",
+                            stacklevel=2,
+                        )
+                        warned = True
                     rec = process(frame)
                     records.append(rec)
                     if writer is not None and sink is not None:
@@ -208,14 +262,28 @@ def frame_records(
     finally:
         if sink is not None:
             sink.close()
-    return records, failure
+    return FrameRecords(records, failure, late["count"])
 
 
-def reader_notes(reader: Any, output: Path | None) -> str:
-    """The end of a per-frame command's summary line: the reader's corrupt frames skipped
-    and images with NaN/inf pixels filled, and the CSV written (empty when none)."""
+def run_summary(run: FrameRecords, keep_up: bool) -> dict[str, Any]:
+    """The JSON document of a per-frame command: ``{"frames": records}``, with
+    ``"frames_dropped"`` when it kept up with its source and ``"error"`` when the source
+    failed mid-stream."""
+    doc: dict[str, Any] = {"frames": run.records}
+    if keep_up:
+        doc["frames_dropped"] = run.dropped
+    if run.failure is not None:
+        doc["error"] = str(run.failure)
+    return doc
+
+
+def reader_notes(reader: Any, output: Path | None, dropped: int = 0) -> str:
+    """The end of a per-frame command's summary line: the frames dropped to keep up, the
+    reader's corrupt frames skipped and images with NaN/inf pixels filled, and the CSV
+    written (empty when none)."""
     return (
-        (f", {reader.skipped} corrupt frame(s) skipped" if reader.skipped else "")
+        (f", {dropped} dropped to keep up" if dropped else "")
+        + (f", {reader.skipped} corrupt frame(s) skipped" if reader.skipped else "")
         + (f", {reader.filled} with NaN/inf pixels filled" if reader.filled else "")
         + (f"; wrote {output}" if output is not None else "")
     )

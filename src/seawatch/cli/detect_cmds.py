@@ -18,7 +18,10 @@ frame is done, so a crash or a dropped stream keeps the frames before it.
 Exit codes: 0 ok; 2 bad input (a missing or undecodable source, an empty folder, a
 source without frames, a missing model file, a bad option), with a message naming the
 input — if frames were processed before the failure, they are kept in the CSV and
-printed (``--json``) with an ``"error"`` entry; 1 for any other failure. Warnings
+printed (``--json``) with an ``"error"`` entry; 1 for any other failure. A live source
+(camera, RTSP …) is kept up with (``--keep-up``, its default there): frames that arrive
+while three wait are dropped unprocessed and counted in the JSON's
+``"frames_dropped"``. Warnings
 (corrupt frames skipped, a size change, a dropped stream, non-image files in a folder)
 go to stderr.
 """
@@ -34,6 +37,7 @@ import typer
 from seawatch.cli._common import (
     EndOption,
     FpsOption,
+    KeepUpOption,
     MaxFramesOption,
     ReconnectOption,
     SourceArgument,
@@ -46,6 +50,7 @@ from seawatch.cli._common import (
     frame_records,
     open_reader,
     reader_notes,
+    run_summary,
     warnings_to_stderr,
 )
 
@@ -157,6 +162,7 @@ def detect(
     end: EndOption = None,
     max_frames: MaxFramesOption = None,
     reconnect: ReconnectOption = 0,
+    keep_up: KeepUpOption = None,
 ) -> None:
     """Detect ships in every frame of a video, stream or image folder.
 
@@ -179,21 +185,24 @@ def detect(
             reconnect=reconnect,
         )  # fmt: skip
         horizon_of = _horizon_source(reader, use_horizon)
-        records, failure = frame_records(
+        keep = bool(reader.realtime) if keep_up is None else keep_up
+        run = frame_records(
             reader,
             f"detect {Path(source).name or source}",
             lambda frame: _record(frame, detector(frame.image, horizon=horizon_of(frame))),
             output=output,
             columns=CSV_COLUMNS,
             csv_rows=_csv_rows,
+            keep_up=keep,
         )
+        records = run.records
         n_boxes = sum(len(rec["boxes"]) for rec in records)
-        err.print(f"{len(records)} frame(s), {n_boxes} box(es)" + reader_notes(reader, output))
+        err.print(
+            f"{len(records)} frame(s), {n_boxes} box(es)"
+            + reader_notes(reader, output, run.dropped)
+        )
         if json_out:
-            doc: dict[str, Any] = {"frames": records}
-            if failure is not None:
-                doc["error"] = str(failure)
-            emit_json(doc)
+            emit_json(run_summary(run, keep))
         elif output is None:
             for rec in records:
                 label = rec.get("file", f"t={rec['time']:.3f}s")
@@ -204,8 +213,8 @@ def detect(
                 sys.stdout.write(
                     f"{rec['index']:6d} {label}  {len(rec['boxes'])} box(es)  {boxes_txt}\n"
                 )
-        if failure is not None:
-            raise failure
+        if run.failure is not None:
+            raise run.failure
 
 
 def _horizon_source(reader: Any, use_horizon: bool) -> Any:

@@ -17,8 +17,11 @@ its frame is done, so a crash or a dropped stream keeps the frames before it.
 Exit codes: 0 ok; 2 bad input (a missing or undecodable source, an empty folder, a
 source without frames, a bad option), with a message naming the input — if frames were
 processed before the failure, they are kept in the CSV and printed (``--json``) with an
-``"error"`` entry; 1 for any other failure. Warnings (corrupt frames skipped, a size
-change, a dropped stream, non-image files in a folder) go to stderr.
+``"error"`` entry; 1 for any other failure. A live source (camera, RTSP …) is kept up
+with (``--keep-up``, its default there): frames that arrive while three wait are
+dropped unprocessed and counted in the JSON's ``"frames_dropped"``. Warnings (corrupt
+frames skipped, a size change, a dropped stream, non-image files in a folder) go to
+stderr.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ import typer
 from seawatch.cli._common import (
     EndOption,
     FpsOption,
+    KeepUpOption,
     MaxFramesOption,
     ReconnectOption,
     SourceArgument,
@@ -44,6 +48,7 @@ from seawatch.cli._common import (
     frame_records,
     open_reader,
     reader_notes,
+    run_summary,
     warnings_to_stderr,
 )
 
@@ -93,6 +98,7 @@ def horizon(
     end: EndOption = None,
     max_frames: MaxFramesOption = None,
     reconnect: ReconnectOption = 0,
+    keep_up: KeepUpOption = None,
     smooth: Annotated[
         bool | None,
         typer.Option(
@@ -128,27 +134,28 @@ def horizon(
                 return _record(frame, tracker.update(frame.image, frame.time))
             return _record(frame, detect_horizon(frame.image, max_tilt_deg=max_tilt))
 
-        records, failure = frame_records(
+        keep = bool(reader.realtime) if keep_up is None else keep_up
+        run = frame_records(
             reader,
             f"horizon {Path(source).name or source}",
             process,
             output=output,
             columns=CSV_COLUMNS,
             csv_rows=lambda rec: [_csv_row(rec)],
+            keep_up=keep,
         )
+        records = run.records
         found = sum(r["found"] for r in records)
         err.print(
-            f"{len(records)} frame(s), horizon found in {found}" + reader_notes(reader, output)
+            f"{len(records)} frame(s), horizon found in {found}"
+            + reader_notes(reader, output, run.dropped)
         )
         if json_out:
-            doc: dict[str, Any] = {"frames": records}
-            if failure is not None:
-                doc["error"] = str(failure)
-            emit_json(doc)
+            emit_json(run_summary(run, keep))
         elif output is None:
             for rec in records:
                 y = "not found" if not rec["found"] else f"y0={rec['y0']:.1f} y1={rec['y1']:.1f}"
                 label = rec.get("file", f"t={rec['time']:.3f}s")
                 sys.stdout.write(f"{rec['index']:6d} {label}  {y}  conf={rec['confidence']:.2f}\n")
-        if failure is not None:
-            raise failure
+        if run.failure is not None:
+            raise run.failure

@@ -15,6 +15,7 @@ from seawatch.cli._common import (
     BadInput,
     EndOption,
     FpsOption,
+    KeepUpOption,
     MaxFramesOption,
     ReconnectOption,
     StepOption,
@@ -158,17 +159,7 @@ def track(
     end: EndOption = None,
     fps: FpsOption = None,
     reconnect: ReconnectOption = 0,
-    keep_up: Annotated[
-        bool | None,
-        typer.Option(
-            "--keep-up/--no-keep-up",
-            help="Drop frames when the job falls behind the source, so that it stays a few "
-            "frames behind instead of ever further (the tracks coast over them; counted in "
-            "the summary's frames_dropped). Default: on for a camera device or an RTSP, RTMP, "
-            "UDP, SRT stream, off for a file, folder or HTTP URL.",
-            show_default=False,
-        ),
-    ] = None,
+    keep_up: KeepUpOption = None,
     video: Annotated[bool, typer.Option(help="Write annotated.mp4.")] = True,
     report: Annotated[bool, typer.Option(help="Write report.html.")] = True,
     parquet: Annotated[bool, typer.Option(help="Also write tracks.parquet (pyarrow).")] = False,
