@@ -481,18 +481,28 @@ def test_track_reconnects_a_dropped_stream_and_keeps_the_ship(clip, tmp_path, st
 def test_track_keep_up_drops_frames_it_is_behind_on_and_a_file_loses_none(clip, tmp_path):
     """``--keep-up`` on a file, which is decoded far faster than it is tracked (as a
     camera that sends frames faster than the job keeps up with): frames are dropped,
-    counted and noted, the ship keeps one track across the gaps, and only the frames
-    tracked have rows. Without it a file loses no frame (the default off a real-time
+    counted and noted, only the frames tracked have rows, and annotated.mp4 shows each
+    of them at its source time. Without it a file loses no frame (the default off a real-time
     source)."""
     args = ["track", str(clip / "video.mp4"), "--keep-up", "--out", str(tmp_path / "out")]
-    res = runner.invoke(app, [*args, "--no-video", "--no-report", "--json"])
+    res = runner.invoke(app, [*args, "--no-report", "--json"])
     assert res.exit_code == 0, res.output
     doc = json.loads(res.stdout[res.stdout.index("{") :])
     assert doc["frames_dropped"] > 0 and doc["frames"] + doc["frames_dropped"] == 80
     assert any("dropped to keep up" in w for w in doc["warnings"])
     rows = _rows(tmp_path / "out" / "tracks.csv")
-    assert len({int(r["frame"]) for r in rows}) <= doc["frames"]
-    assert len(_track_ids(rows, range(80))) == 1
+    tracked = {int(r["frame"]) for r in rows}
+    assert 0 < len(tracked) <= doc["frames"]  # (gaps the tracks cannot coast over vary
+    # with the host's speed: on a fast one decoding outruns tracking by far more)
+    # annotated.mp4 shows each frame tracked at its source time, the dropped ones a gap
+    import av
+
+    with av.open(str(tmp_path / "out" / "annotated.mp4")) as video:
+        stream = video.streams.video[0]
+        pts = [f.pts for f in video.decode(stream)]  # from the codec's delay on
+    shown = [round(float((t - pts[0]) * stream.time_base) * 25.0) for t in pts]  # frame 0 on
+    assert len(shown) == doc["frames"] and np.all(np.diff(shown) > 0)
+    assert tracked <= set(shown) and max(shown) < 80
     run = track_video(clip / "video.mp4", tmp_path / "all", annotate=False, report=False)
     assert run.frames == 80 and run.frames_dropped == 0
     assert run.to_json()["frames_dropped"] == 0

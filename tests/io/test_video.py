@@ -171,6 +171,28 @@ def test_writer_rejects_bad_frames_and_writes_no_file_without_frames(tmp_path: P
     assert not empty.exists()
 
 
+
+def test_frames_written_at_their_pts_keep_their_times_across_gaps(tmp_path: Path):
+    """Frames given presentation times with gaps (frames dropped upstream) are read back
+    at those times, with the source's indices and pixels, the gaps reported as missing
+    frames (the stream's base rate, 25/s, is kept: a sixth of its frames are gone); a
+    pts not after the last one is refused."""
+    path = tmp_path / "gaps.mp4"
+    pts = [0, 1, 2, 3, 5, 6, 7, 9, 10]  # 4 and 8 dropped
+    with VideoWriter(path, fps=25.0, crf=0) as writer:
+        for k in pts:
+            writer.write(_pattern(k), pts=k)
+        for bad in (10, 4, 11.5, True):
+            with pytest.raises(ValueError, match="pts"):
+                writer.write(_pattern(0), pts=bad)
+        writer.write(_pattern(11))  # the default: the frame after the last
+    with pytest.warns(VideoWarning, match="1 frame\\(s\\) missing between 0.280"):
+        frames = list(VideoReader(path))
+    assert [f.index for f in frames] == [*pts, 11]
+    assert [f.time for f in frames] == pytest.approx([k / 25.0 for k in [*pts, 11]])
+    for f in frames:
+        assert np.mean(np.abs(_gray(f.image) - _gray(_pattern(f.index)))) < 3.0
+
 # ----------------------------------------------------------------------------- corruption
 def test_bytes_overwritten_mid_file_skip_and_count_frames_without_failing(
     clip: Path, tmp_path: Path

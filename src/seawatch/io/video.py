@@ -1062,6 +1062,7 @@ class VideoWriter:
         self.options = dict(options or {})
         self.container_options = dict(container_options or {})
         self.frames_written = 0
+        self._last_pts = -1  # the last frame's presentation time [frame periods]
         self._container: Any = None
         self._stream: Any = None
         self._shape: tuple[int, ...] | None = None
@@ -1142,10 +1143,20 @@ class VideoWriter:
         self._container, self._stream, self._pad = container, stream, pad
         self._shape = image.shape
 
-    def write(self, image: NDArray[Any]) -> None:
-        """Append one frame (BGR/BGRA/gray uint8, or gray uint16 with a 16-bit codec)."""
+    def write(self, image: NDArray[Any], pts: int | None = None) -> None:
+        """Append one frame (BGR/BGRA/gray uint8, or gray uint16 with a 16-bit codec).
+
+        ``pts``: the frame's presentation time in frame periods (``1 / fps``) from the
+        video's start, after the last frame's — a gap leaves the frames between out and
+        keeps the later ones at their times (frames dropped or lost upstream); default:
+        the frame after the last one.
+        """
         if self._closed:
             raise ValueError(f"{self.path}: writer is closed")
+        if pts is not None and (isinstance(pts, bool) or int(pts) != pts or pts <= self._last_pts):
+            raise ValueError(
+                f"pts: expected an integer after the last frame's ({self._last_pts}), got {pts!r}"
+            )
         img = np.asarray(image)
         if img.ndim == 3 and img.shape[2] == 4:
             img = img[:, :, :3]
@@ -1172,7 +1183,7 @@ class VideoWriter:
             img = np.pad(img, pad, mode="edge")
         fmt = "gray16le" if self._deep else ("gray" if img.ndim == 2 else "bgr24")
         frame = av.VideoFrame.from_ndarray(np.ascontiguousarray(img), format=fmt)
-        frame.pts = self.frames_written
+        frame.pts = self._last_pts = self._last_pts + 1 if pts is None else int(pts)
         for packet in self._stream.encode(frame):
             self._container.mux(packet)
         self.frames_written += 1

@@ -326,9 +326,13 @@ class AnnotatedVideo:
         time: float | None = None,
         frame: int | None = None,
         fit: bool = False,
+        pts: int | None = None,
     ) -> None:
         """Annotate one frame (:meth:`Annotator.draw`) and append it to the video.
 
+        ``pts``: its presentation time in frame periods from the video's start
+        (:meth:`seawatch.io.video.VideoWriter.write`; default the next frame), so that
+        frames dropped or lost before it leave a gap in time, not a jump in the motion.
         ``fit``: a frame of another size than the video's (a stream whose resolution
         changed) is drawn at its own size and then scaled to the video's; without it such
         a frame is a ValueError."""
@@ -343,7 +347,7 @@ class AnnotatedVideo:
         drawn = self.annotator.draw(image, tracks, horizon, time=time, frame=frame)
         if other:
             drawn = cv2.resize(drawn, self.size, interpolation=cv2.INTER_AREA)
-        self._writer.write(drawn)
+        self._writer.write(drawn, pts)
 
     def close(self) -> None:
         """Finish the file (idempotent; no frames → no file, with a warning)."""
