@@ -712,6 +712,17 @@ class PreparedFrame:
 
 _NO_SIGN = np.full((1, 1), 3, np.uint8)  # one polarity only: every pixel joins
 
+
+def _polarity_bits(d: NDArray, out: NDArray | None = None) -> NDArray:
+    """Each pixel's polarity bits for :func:`_grow_kernel` from the signed contrast ``d``
+    (grey levels): 1 brighter than its background (``d > 0``), 2 darker (``d <= 0``);
+    written into ``out`` (uint8, the shape of ``d``) when given."""
+    bits = np.empty(d.shape, np.uint8) if out is None else out
+    np.less_equal(d, 0, out=bits.view(np.bool_))
+    bits += 1
+    return bits
+
+
 _POLARITY_CODE = {"both": 0, "bright": 1, "dark": 2}  # the contrast kernels' ``polarity``
 
 _CENSOR_GAP = 3
@@ -1280,9 +1291,7 @@ class ClassicalShipDetector:
         z = np.divide(c, sigma, out=c)
         sign = _NO_SIGN
         if pol == 0:  # bright where g > (L + R)/2 (then g − max(L, R) > min(L, R) − g)
-            sign = self._work(f"sign{factor}", d.shape, np.uint8)
-            np.less_equal(d, 0, out=sign.view(np.bool_))
-            sign += 1
+            sign = _polarity_bits(d, self._work(f"sign{factor}", d.shape, np.uint8))
         chroma = None
         if factor == 1 and fr.chroma:
             chroma = []
@@ -1464,7 +1473,7 @@ class ClassicalShipDetector:
             z *= keep[r0:r1, c0:c1]  # a candidate's own pixels join no component
             sign = _NO_SIGN
             if pol == 0:
-                sign = (d <= 0).view(np.uint8) + np.uint8(1)
+                sign = _polarity_bits(d)
             boxes, peaks, _, pols = _grow_kernel(
                 z,
                 sign,
