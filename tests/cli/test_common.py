@@ -21,15 +21,16 @@ def _folder(tmp_path: Path, n: int) -> Path:
 
 
 def _slow(frame) -> dict:
-    time.sleep(0.05)  # a consumer far slower than the folder is read
+    time.sleep(0.1)  # a consumer far slower than the folder is read
     return {"index": int(frame.index)}
 
 
 def test_keep_up_drops_what_arrives_while_the_queue_is_full(tmp_path):
-    """20 images read in a few ms against 50 ms of work each: the loop processes the
-    first frame and the ``KEEP_UP_DEPTH`` that wait behind it at most a frame or two
-    later, drops the rest unprocessed, counts them and warns once; every frame is
-    processed or counted, in order."""
+    """20 images read in a few ms against 0.1 s of work each: the loop processes the
+    ``KEEP_UP_DEPTH`` frames that wait (and the first, if it was taken up before they
+    were queued, and a frame or two more on a loaded machine), drops the rest
+    unprocessed, counts them and warns once; every frame is processed or counted, in
+    order."""
     reader = VideoReader(_folder(tmp_path, 20), fps=25.0)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -37,7 +38,7 @@ def test_keep_up_drops_what_arrives_while_the_queue_is_full(tmp_path):
                             keep_up=True)  # fmt: skip
     index = [r["index"] for r in run.records]
     assert len(index) + run.dropped == 20 and index == sorted(index)
-    assert index[0] == 0 and KEEP_UP_DEPTH + 1 <= len(index) <= KEEP_UP_DEPTH + 4
+    assert index[0] == 0 and KEEP_UP_DEPTH <= len(index) <= KEEP_UP_DEPTH + 4
     assert run.failure is None
     assert sum("dropped to keep up" in str(w.message) for w in caught) == 1
     assert run_summary(run, True)["frames_dropped"] == run.dropped

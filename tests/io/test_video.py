@@ -171,7 +171,6 @@ def test_writer_rejects_bad_frames_and_writes_no_file_without_frames(tmp_path: P
     assert not empty.exists()
 
 
-
 def test_frames_written_at_their_pts_keep_their_times_across_gaps(tmp_path: Path):
     """Frames given presentation times with gaps (frames dropped upstream) are read back
     at those times, with the source's indices and pixels, the gaps reported as missing
@@ -192,6 +191,7 @@ def test_frames_written_at_their_pts_keep_their_times_across_gaps(tmp_path: Path
     assert [f.time for f in frames] == pytest.approx([k / 25.0 for k in [*pts, 11]])
     for f in frames:
         assert np.mean(np.abs(_gray(f.image) - _gray(_pattern(f.index)))) < 3.0
+
 
 # ----------------------------------------------------------------------------- corruption
 def test_bytes_overwritten_mid_file_skip_and_count_frames_without_failing(
