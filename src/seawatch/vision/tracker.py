@@ -558,11 +558,12 @@ class VisualTracker:
         frames behind is dropped before its horizon and ships are looked for
         (:func:`~seawatch.io.prefetch.prefetch`'s ``skip``), so that the frames given
         stay a few frames behind the source instead of ever further (1080p on two
-        cores: the track job runs at 21–25 frames/s by the hour; at 23.5 frames/s it fell
-        a second further behind a 25 frames/s camera every 16–20 s). The frames dropped
-        are counted in :attr:`frames_dropped` and are missing from the iteration like
-        frames the source lost: :meth:`coast_to` (or :meth:`track_frames`) coasts over
-        them by their indices; a warning says when the first is dropped.
+        cores without AVX-512: the track job runs at 21–25 frames/s by the hour; at 23.5
+        frames/s it fell a second further behind a 25 frames/s camera every 16–20 s).
+        The frames dropped are counted in :attr:`frames_dropped` and are missing from the
+        iteration like frames the source lost: :meth:`coast_to` (or
+        :meth:`track_frames`) coasts over them by their indices; a warning says when the
+        first is dropped.
 
         Args:
             frames: images (H, W[, C]) or :class:`seawatch.io.video.Frame` objects (their
