@@ -65,7 +65,7 @@ KeepUpOption = Annotated[
         "--keep-up/--no-keep-up",
         help="Drop frames when the command falls behind the source, so that it stays a few "
         "frames behind instead of ever further (counted in the JSON's frames_dropped; "
-        "tracks coast over them). "
+        "`track` coasts its tracks over them). "
         "Default: on for a camera device or an RTSP, RTMP, UDP, SRT stream, off for a "
         "file, folder or HTTP URL.",
         show_default=False,
