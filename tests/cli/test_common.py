@@ -10,7 +10,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from seawatch.cli._common import KEEP_UP_DEPTH, frame_records, run_summary
+from seawatch.cli._common import frame_records, run_summary
+from seawatch.io.prefetch import DEPTH
 from seawatch.io.video import VideoReader
 
 
@@ -27,7 +28,7 @@ def _slow(frame) -> dict:
 
 def test_keep_up_drops_what_arrives_while_the_queue_is_full(tmp_path):
     """20 images read in a few ms against 0.1 s of work each: the loop processes the
-    ``KEEP_UP_DEPTH`` frames that wait (and the first, if it was taken up before they
+    ``DEPTH`` frames that wait (and the first, if it was taken up before they
     were queued, and a frame or two more on a loaded machine), drops the rest
     unprocessed, counts them and warns once; every frame is processed or counted, in
     order."""
@@ -38,7 +39,7 @@ def test_keep_up_drops_what_arrives_while_the_queue_is_full(tmp_path):
                             keep_up=True)  # fmt: skip
     index = [r["index"] for r in run.records]
     assert len(index) + run.dropped == 20 and index == sorted(index)
-    assert index[0] == 0 and KEEP_UP_DEPTH <= len(index) <= KEEP_UP_DEPTH + 4
+    assert index[0] == 0 and DEPTH <= len(index) <= DEPTH + 4
     assert run.failure is None
     assert sum("dropped to keep up" in str(w.message) for w in caught) == 1
     assert run_summary(run, True)["frames_dropped"] == run.dropped

@@ -72,10 +72,6 @@ KeepUpOption = Annotated[
     ),
 ]
 
-KEEP_UP_DEPTH = 3
-"""Frames that may wait for a keeping-up command before the next one is dropped (as in
-:meth:`seawatch.vision.tracker.VisualTracker.stream`)."""
-
 
 def open_reader(
     source: str,
@@ -214,7 +210,8 @@ def frame_records(
 
     With ``keep_up`` the frames are read in a background thread
     (:func:`seawatch.io.prefetch.prefetch`) and one that arrives while
-    :data:`KEEP_UP_DEPTH` frames already wait is dropped unprocessed and counted: a
+    :data:`seawatch.io.prefetch.DEPTH` frames already wait is dropped unprocessed and
+    counted (as in :meth:`seawatch.vision.tracker.VisualTracker.stream`): a
     live camera does not wait for a command slower than its frame rate, and without
     dropping the backlog (and the delay of every record) grows without bound. A warning
     names the first frame dropped.
@@ -223,18 +220,12 @@ def frame_records(
 
     records: list[dict[str, Any]] = []
     failure: Exception | None = None
-    late: dict[str, Any] = {"count": 0, "first": None}  # written by the read thread
+    from seawatch.io.prefetch import Skipped, prefetch
 
-    def drop(frame: Any) -> None:
-        if late["first"] is None:
-            late["first"] = getattr(frame, "index", "?")
-        late["count"] += 1
-
+    late = Skipped()
     frames: Iterable[Any] = reader
     if keep_up:
-        from seawatch.io.prefetch import prefetch
-
-        frames = prefetch(reader, depth=KEEP_UP_DEPTH, name="seawatch-read", skip=drop)
+        frames = prefetch(reader, name="seawatch-read", skip=late)
     warned = False
     sink, writer = open_csv(output, columns)
     try:
@@ -242,9 +233,9 @@ def frame_records(
             task = bar.add_task(label, total=reader.expected_frames)
             try:
                 for frame in frames:
-                    if late["count"] and not warned:
+                    if late.count and not warned:
                         warnings.warn(
-                            f"frame {late['first']}: processing is behind the source; "
+                            f"frame {late.first}: processing is behind the source; "
                             "frames are dropped to keep up with it",
                             stacklevel=2,
                         )
@@ -262,7 +253,7 @@ def frame_records(
     finally:
         if sink is not None:
             sink.close()
-    return FrameRecords(records, failure, late["count"])
+    return FrameRecords(records, failure, late.count)
 
 
 def run_summary(run: FrameRecords, keep_up: bool) -> dict[str, Any]:

@@ -19,10 +19,30 @@ T = TypeVar("T")
 
 _ITEM, _ERROR, _END = 0, 1, 2
 
+DEPTH = 3
+"""Items that may wait for the consumer by default (:func:`prefetch`'s ``depth``): with
+``skip``, how far a consumer may fall behind a live source before its items are dropped."""
+
+
+class Skipped:
+    """A ``skip`` for :func:`prefetch` that counts the items it is handed and remembers
+    the first one's ``index`` (``"?"`` for an item without one). Its attributes are
+    written by the prefetch thread and read by the consumer (an int and a reference:
+    each assignment is atomic)."""
+
+    def __init__(self) -> None:
+        self.count = 0
+        self.first: Any = None
+
+    def __call__(self, item: Any) -> None:
+        if self.first is None:
+            self.first = getattr(item, "index", "?")
+        self.count += 1
+
 
 def prefetch(
     items: Iterable[Any],
-    depth: int = 3,
+    depth: int = DEPTH,
     work: Callable[[Any], T] | None = None,
     name: str = "seawatch-prefetch",
     skip: Callable[[Any], None] | None = None,

@@ -599,7 +599,7 @@ class VisualTracker:
             return
         import cv2
 
-        from seawatch.io.prefetch import prefetch
+        from seawatch.io.prefetch import Skipped, prefetch
 
         # OpenCV's own worker threads wait for work by spinning: beside the stream's two
         # threads on two cores they burnt 3.5 ms of CPU per 1080p frame and gave nothing
@@ -608,25 +608,19 @@ class VisualTracker:
         cv2.setNumThreads(1)
         if keep_up is None:
             keep_up = bool(getattr(frames, "realtime", False))
-        late: dict[str, Any] = {"count": 0, "first": None}  # written by the read thread
-
-        def drop(fr: Any) -> None:
-            if late["first"] is None:
-                late["first"] = getattr(fr, "index", "?")
-            late["count"] += 1
-
+        late = Skipped()
         try:
-            ready = prefetch(frames, work=horizon, name=READ_THREAD, skip=drop if keep_up else None)
+            ready = prefetch(frames, work=horizon, name=READ_THREAD, skip=late if keep_up else None)
             for item in prefetch(ready, work=detect, name=DETECT_THREAD):
-                if late["count"] and not self.frames_dropped:
+                if late.count and not self.frames_dropped:
                     warnings.warn(
-                        f"frame {late['first']}: processing is behind the source; frames "
+                        f"frame {late.first}: processing is behind the source; frames "
                         "are dropped to keep up with it (their tracks coast)",
                         stacklevel=2,
                     )
-                self.frames_dropped = late["count"]
+                self.frames_dropped = late.count
                 yield item
-            self.frames_dropped = late["count"]
+            self.frames_dropped = late.count
         finally:
             cv2.setNumThreads(threads)
 
