@@ -581,7 +581,7 @@ def track_video(
         associator = AisAssociator(ais, lat0=lat0, lon0=lon0)
         ais_every = max(1, round(fps / step / AIS_RATE))
     video_out = None
-    first_index, last_pts = 0, -1  # annotated.mp4's first source frame and last pts
+    first_index = 0  # annotated.mp4's first source frame
     total = reader.expected_frames
     done: list[int] = []  # source indices of the frames tracked (scored with --truth)
     ids: set[int] = set()
@@ -720,7 +720,7 @@ def track_video(
                     video_out = AnnotatedVideo(out / "annotated.mp4", fps / step, (w, h))
                     first_index = int(frame.index)
                 # at the source's time: frames dropped to keep up or lost leave gaps
-                pts = last_pts = max((int(frame.index) - first_index) // step, last_pts + 1)
+                pts = max((int(frame.index) - first_index) // step, video_out.last_pts + 1)
                 video_out.write(
                     frame.image, records, horizon, time=t, frame=int(frame.index), fit=True,
                     pts=pts,

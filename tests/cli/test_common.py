@@ -42,11 +42,11 @@ def test_keep_up_drops_what_arrives_while_the_queue_is_full(tmp_path):
     assert index[0] == 0 and DEPTH <= len(index) <= DEPTH + 4
     assert run.failure is None
     assert sum("dropped to keep up" in str(w.message) for w in caught) == 1
-    assert run_summary(run, True)["frames_dropped"] == run.dropped
+    assert run_summary(run)["frames_dropped"] == run.dropped
 
 
 def test_without_keep_up_a_slow_consumer_loses_nothing(tmp_path):
     reader = VideoReader(_folder(tmp_path, 6), fps=25.0)
     run = frame_records(reader, "t", _slow, output=None, columns=(), csv_rows=list)
     assert [r["index"] for r in run.records] == list(range(6)) and run.dropped == 0
-    assert set(run_summary(run, False)) == {"frames"}
+    assert set(run_summary(run)) == {"frames"}

@@ -182,11 +182,12 @@ def open_csv(output: Path | None, columns: Sequence[str]) -> tuple[TextIO | None
 
 class FrameRecords(NamedTuple):
     """What :func:`frame_records` returns: the records of the frames processed, the
-    source's failure that ended the loop (None when it ran to the end) and the frames
-    dropped to keep up with a real-time source."""
+    source's failure that ended the loop (None when it ran to the end), whether it kept
+    up with its source and the frames it dropped to."""
 
     records: list[dict[str, Any]]
     failure: Exception | None
+    kept_up: bool
     dropped: int
 
 
@@ -198,7 +199,7 @@ def frame_records(
     output: Path | None,
     columns: Sequence[str],
     csv_rows: Callable[[dict[str, Any]], list[list[str]]],
-    keep_up: bool = False,
+    keep_up: bool | None = None,
 ) -> FrameRecords:
     """Run ``process(frame) -> record`` over a :class:`~seawatch.io.video.VideoReader`.
 
@@ -214,7 +215,8 @@ def frame_records(
     counted (as in :meth:`seawatch.vision.tracker.VisualTracker.stream`): a
     live camera does not wait for a command slower than its frame rate, and without
     dropping the backlog (and the delay of every record) grows without bound. A warning
-    names the first frame dropped.
+    names the first frame dropped. ``keep_up=None`` (default): when the reader's source
+    is real-time (:attr:`seawatch.io.video.VideoReader.realtime`).
     """
     from seawatch.io.video import VideoError
 
@@ -223,6 +225,8 @@ def frame_records(
     from seawatch.io.prefetch import Skipped, prefetch
 
     late = Skipped()
+    if keep_up is None:
+        keep_up = bool(getattr(reader, "realtime", False))
     frames: Iterable[Any] = reader
     if keep_up:
         frames = prefetch(reader, name="seawatch-read", skip=late)
@@ -253,15 +257,15 @@ def frame_records(
     finally:
         if sink is not None:
             sink.close()
-    return FrameRecords(records, failure, late.count)
+    return FrameRecords(records, failure, keep_up, late.count)
 
 
-def run_summary(run: FrameRecords, keep_up: bool) -> dict[str, Any]:
+def run_summary(run: FrameRecords) -> dict[str, Any]:
     """The JSON document of a per-frame command: ``{"frames": records}``, with
     ``"frames_dropped"`` when it kept up with its source and ``"error"`` when the source
     failed mid-stream."""
     doc: dict[str, Any] = {"frames": run.records}
-    if keep_up:
+    if run.kept_up:
         doc["frames_dropped"] = run.dropped
     if run.failure is not None:
         doc["error"] = str(run.failure)

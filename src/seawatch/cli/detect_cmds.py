@@ -185,7 +185,6 @@ def detect(
             reconnect=reconnect,
         )  # fmt: skip
         horizon_of = _horizon_source(reader, use_horizon)
-        keep = bool(reader.realtime) if keep_up is None else keep_up
         run = frame_records(
             reader,
             f"detect {Path(source).name or source}",
@@ -193,7 +192,7 @@ def detect(
             output=output,
             columns=CSV_COLUMNS,
             csv_rows=_csv_rows,
-            keep_up=keep,
+            keep_up=keep_up,
         )
         records = run.records
         n_boxes = sum(len(rec["boxes"]) for rec in records)
@@ -202,7 +201,7 @@ def detect(
             + reader_notes(reader, output, run.dropped)
         )
         if json_out:
-            emit_json(run_summary(run, keep))
+            emit_json(run_summary(run))
         elif output is None:
             for rec in records:
                 label = rec.get("file", f"t={rec['time']:.3f}s")

@@ -134,7 +134,6 @@ def horizon(
                 return _record(frame, tracker.update(frame.image, frame.time))
             return _record(frame, detect_horizon(frame.image, max_tilt_deg=max_tilt))
 
-        keep = bool(reader.realtime) if keep_up is None else keep_up
         run = frame_records(
             reader,
             f"horizon {Path(source).name or source}",
@@ -142,7 +141,7 @@ def horizon(
             output=output,
             columns=CSV_COLUMNS,
             csv_rows=lambda rec: [_csv_row(rec)],
-            keep_up=keep,
+            keep_up=keep_up,
         )
         records = run.records
         found = sum(r["found"] for r in records)
@@ -151,7 +150,7 @@ def horizon(
             + reader_notes(reader, output, run.dropped)
         )
         if json_out:
-            emit_json(run_summary(run, keep))
+            emit_json(run_summary(run))
         elif output is None:
             for rec in records:
                 y = "not found" if not rec["found"] else f"y0={rec['y0']:.1f} y1={rec['y1']:.1f}"

@@ -1143,6 +1143,11 @@ class VideoWriter:
         self._container, self._stream, self._pad = container, stream, pad
         self._shape = image.shape
 
+    @property
+    def last_pts(self) -> int:
+        """The last frame's presentation time [frame periods]; -1 before the first."""
+        return self._last_pts
+
     def write(self, image: NDArray[Any], pts: int | None = None) -> None:
         """Append one frame (BGR/BGRA/gray uint8, or gray uint16 with a 16-bit codec).
 

@@ -317,6 +317,11 @@ class AnnotatedVideo:
         """Frames encoded so far [-]."""
         return self._writer.frames_written
 
+    @property
+    def last_pts(self) -> int:
+        """The last frame's presentation time [frame periods]; -1 before the first."""
+        return self._writer.last_pts
+
     def write(
         self,
         image: NDArray[Any],
