@@ -531,6 +531,64 @@ def test_coast_ratio_bounds_coasting_by_the_detections_a_track_has_had(ratio):
         assert alive == limit - 1, (seen, ratio, alive)  # deleted on the limit-th miss
 
 
+@pytest.mark.parametrize("factory", [None, AdaptiveFractionalKalmanFilter])
+def test_scans_not_made_are_no_misses_of_the_evidence_rules(factory):
+    """A point moving 1 unit a scan, detected in every third scan, the two between not
+    made (frames dropped to keep up with a live source: ``observed=False``). The M-of-N
+    window counts the scans made: 3-of-5 confirms at the third detection (scan 6), as
+    with every scan made. Taken as empty scans (the frames looked at and nothing
+    found) the same detections never reach 3 of 5 and every track dies tentative. The
+    track's state is predicted over the scans not made: at the last detection it is
+    on the point to 0.1 (σ_z = 1), its velocity the point's per scan, with the same id
+    throughout."""
+
+    def run(observed: bool) -> list:
+        trk = _tracker(filter_factory=factory, confirm_m=3, confirm_n=5, delete_after=12)
+        out = []
+        for k in range(30):
+            if k % 3 == 0:
+                out.append(trk.step(np.array([[10.0 + k, 5.0]]), float(k)))
+            elif observed:
+                trk.step(None, float(k))
+            else:
+                trk.step(None, float(k), observed=False)
+        return out
+
+    made = run(observed=False)
+    assert [bool(st.confirmed.any()) for st in made[:4]] == [False, False, True, True]
+    assert {int(i) for st in made for i in st.ids} == {1}
+    assert np.abs(made[-1].positions - [[37.0, 5.0]]).max() < 0.1
+    assert abs(made[-1].states[0, 2] - 1.0) < 0.3  # units per scan, not per scan made
+    assert made[-1].misses.tolist() == [0] and made[-1].hits.tolist() == [10]
+    empty = run(observed=True)
+    assert not any(st.confirmed.any() for st in empty)
+
+
+def test_scans_not_made_count_towards_delete_after_but_not_the_coast_ratio():
+    """A point seen in 4 scans (confirmed), then never again. With ``coast_ratio`` 1 it
+    is deleted at its 4th scan made without it; scans not made between do not count
+    there, but every scan, made or not, counts towards ``delete_after`` (12): it bounds
+    the time a track lives on prediction alone — 11 scans not made and the track is
+    still there, the 12th deletes it, and a tentative track the same. A scan not made
+    carries no detections."""
+    trk = _tracker(confirm_m=3, confirm_n=3, delete_after=12, coast_ratio=1.0)
+    for k in range(4):
+        trk.step(np.array([[10.0 + k, 5.0]]))
+    for _ in range(3):  # 3 misses of scans made, each after a scan not made
+        trk.step(None, observed=False)
+        assert len(trk.step(None)) == 1
+    assert trk.step(None, observed=False).misses.tolist() == [7]
+    assert len(trk.step(None)) == 0  # the 4th miss of a scan made: 4 >= 1 × 4 hits
+    for confirm in ((3, 3), (3, 5)):
+        trk = _tracker(confirm_m=confirm[0], confirm_n=confirm[1], delete_after=12)
+        for k in range(3):
+            trk.step(np.array([[10.0 + k, 5.0]]))
+        alive = [len(trk.step(None, observed=False)) for _ in range(12)]
+        assert alive == [1] * 11 + [0]
+    with pytest.raises(ValueError, match="detections"):
+        _tracker().step(np.array([[1.0, 2.0]]), observed=False)
+
+
 def test_confirmed_first_keeps_a_detection_for_the_confirmed_track():
     """Matching cascade: a detection between an established track (3 px away) and a
     track born on it one scan before (on it) goes to the established one; without the

@@ -139,6 +139,35 @@ def test_track_frames_coasts_over_frames_whose_index_skips():
     assert frames_lost(13, 5, step=5) == 1  # 8 frames: nearer two steps than one
 
 
+def test_a_boat_seen_in_every_third_frame_is_tracked_from_its_third():
+    """Keep-up on a source three times faster than the job: only every third frame
+    (indices 0, 3, 6, …) reaches ``track_frames``. The frames between were never looked
+    at, so they are no misses: the boat's track is confirmed at the third frame given
+    (3-of-5 among the frames given), keeps one id, and its box is on the boat at every
+    frame given after (to 1 px; 4 px a frame, 12 px between frames given). Counted as
+    frames without the boat (session 25's code), 3 of 5 was never reached and the boat
+    was never tracked."""
+    from seawatch.io.video import Frame
+
+    frames = []
+    for k in range(0, 90, 3):
+        img = np.zeros((8, 8), np.uint8)
+        img[0, 0] = k
+        frames.append(Frame(index=k, time=k / 25.0, image=img))
+
+    def boat(image, **_):
+        k = int(image[0, 0])
+        return np.array([[100.0 + 4.0 * k, 200.0, 10.0, 4.0]])
+
+    for name in ("afkf", "kf"):
+        vt = VisualTracker(detector=boat, filter=name, horizon=False, motion=False)
+        out = vt.track_frames(frames, ahead=False)
+        assert [t.shape[0] for t in out[:4]] == [0, 0, 1, 1]
+        assert {int(i) for t in out for i in t[:, 0]} == {1}
+        for fr, t in zip(frames[2:], out[2:], strict=True):
+            assert np.abs(t[0, 1:3] - [100.0 + 4.0 * fr.index, 200.0]).max() < 1.0
+
+
 def test_waterline_defaults_to_box_bottom_centre():
     vt = VisualTracker(detector=lambda *a, **k: None, horizon=False, filter="kf")
     out = [vt.update(np.array([[10.0, 20.0, 8.0, 4.0]])) for _ in range(4)]

@@ -453,6 +453,7 @@ class MultiTargetTracker:
         self._age = np.empty(0, np.int64)  # scans since birth, birth scan = 1
         self._hits = np.empty(0, np.int64)
         self._misses = np.empty(0, np.int64)
+        self._unseen = np.empty(0, np.int64)  # scans not made among the misses
         self._confirmed = np.empty(0, bool)
         self._size = np.empty((0, 2))
         self._filters: list[TrackFilter] = []
@@ -517,6 +518,7 @@ class MultiTargetTracker:
         time: float | None = None,
         *,
         stale: ArrayLike | None = None,
+        observed: bool = True,
     ) -> TrackStates:
         """Process one scan of detections and return the live tracks.
 
@@ -535,10 +537,23 @@ class MultiTargetTracker:
                 (and start tracks) as usual, and a track that takes one counts a hit,
                 but its filter only predicts and its size is kept. None: every
                 detection is new.
+            observed: False for a scan that was not made (a frame the source lost or
+                that was dropped to keep up with it; ``detections`` must then be None):
+                the tracks are predicted to ``time`` and their consecutive misses go on
+                (``delete_after`` bounds the time a track lives on prediction alone),
+                but the scan is none of the evidence rules' scans — the M-of-N window
+                does not move, and ``coast_ratio`` counts only the misses of scans made.
+                A ship that was not looked for was not missed: with every other frame
+                dropped a new track still confirms on three detections, and a track is
+                not deleted for frames it was not looked for in.
 
         Returns:
             :class:`TrackStates` of every live track after this scan.
         """
+        if not observed:
+            if detections is not None:
+                raise ValueError("detections: a scan not made (observed=False) has none")
+            return self._unobserved(self._step_time(time))
         centres, sizes = self._detections(detections)
         repeat = np.zeros(centres.shape[0], bool)
         if stale is not None:
@@ -610,13 +625,15 @@ class MultiTargetTracker:
         self._age += 1
         self._hits += assigned
         self._misses = np.where(assigned, 0, self._misses + 1)
+        self._unseen = np.where(assigned, 0, self._unseen)
         window_hits = _popcount(self._history)
         newly = ~self._confirmed & (window_hits >= self.confirm_m)
         self._confirmed |= newly
         can_confirm = window_hits + np.maximum(self.confirm_n - self._age, 0) >= self.confirm_m
         limit = np.full(self.n_tracks, float(self.delete_after))
         if self.coast_ratio is not None:
-            limit = np.minimum(limit, np.maximum(self.coast_ratio * self._hits, 1.0))
+            ratio = np.maximum(self.coast_ratio * self._hits, 1.0)
+            limit = np.minimum(limit, ratio + self._unseen)  # the ratio: scans made only
         keep = np.where(self._confirmed, self._misses < limit, can_confirm) & ~dead
         self._compress(keep)
         detection = detection[keep]
@@ -632,6 +649,17 @@ class MultiTargetTracker:
         anchored = np.concatenate([anchored, np.zeros(births.size, bool)])
         self._time = t
         return self._report(t, detection, restarted, anchored)
+
+    def _unobserved(self, t: float) -> TrackStates:
+        """A scan not made (:meth:`step`'s ``observed=False``): predict, count the miss
+        towards ``delete_after`` only, delete the tracks past it."""
+        self._predict(self.dt if self._time is None else t - self._time)
+        self._S = None
+        self._misses += 1
+        self._unseen += 1
+        self._compress(self._misses < self.delete_after)
+        self._time = t
+        return self._report(t, np.full(self.n_tracks, -1, np.int64))
 
     def run(
         self, scans: Sequence[ArrayLike | None], times: ArrayLike | None = None
@@ -1166,6 +1194,7 @@ class MultiTargetTracker:
         self._age = self._age[keep]
         self._hits = self._hits[keep]
         self._misses = self._misses[keep]
+        self._unseen = self._unseen[keep]
         self._confirmed = self._confirmed[keep]
         self._size = self._size[keep]
         if self._filters:
@@ -1231,6 +1260,7 @@ class MultiTargetTracker:
         self._age = np.concatenate([self._age, ones])
         self._hits = np.concatenate([self._hits, ones])
         self._misses = np.concatenate([self._misses, np.zeros(k, np.int64)])
+        self._unseen = np.concatenate([self._unseen, np.zeros(k, np.int64)])
         self._confirmed = np.concatenate([self._confirmed, np.full(k, self.confirm_m <= 1)])
         size = np.zeros((k, 2)) if sizes is None else sizes
         self._size = np.concatenate([self._size, size])

@@ -510,14 +510,18 @@ class VisualTracker:
 
     def coast(self, frames: int) -> None:
         """Predict every track over ``frames`` frames lost before the next one (a stream
-        or recording that dropped them): empty scans at the last camera offset, so the
-        filters, whose model steps one frame at a time, keep their velocities per frame
-        and the missed frames count towards deletion (none once no track is left)."""
+        or recording that dropped them, or frames dropped to keep up with a live
+        source): scans not made, at the last camera offset
+        (:meth:`~seawatch.tracking.mtt.MultiTargetTracker.step`'s ``observed=False``),
+        so the filters, whose model steps one frame at a time, keep their velocities
+        per frame; the lost frames count towards ``delete_after`` (the time a track
+        coasts) but not as misses of the evidence rules (M-of-N confirmation,
+        ``coast_ratio``): a ship not looked for was not missed."""
         for _ in range(integer("frames", frames, 0)):
             self._forget_repeats()  # a frame lost between: no longer the one before
             if self.mtt.n_tracks == 0:
                 break
-            self.mtt.step(None, float(self._frame))
+            self.mtt.step(None, float(self._frame), observed=False)
             self._frame += 1
 
     def coast_to(self, index: int, step: int = 1) -> None:
