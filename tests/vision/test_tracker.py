@@ -113,24 +113,31 @@ def test_a_repeated_box_is_no_new_measurement(name):
     assert abs(out[-1][1] - truth[-1]) < 0.1
 
 
+def _numbered_frames(indices):
+    """``Frame`` objects of the given source indices at 25 frames/s, each image holding
+    its index in pixel (0, 0), for :func:`_boat_detector`."""
+    from seawatch.io.video import Frame
+
+    frames = []
+    for k in indices:
+        img = np.zeros((8, 8), np.uint8)
+        img[0, 0] = k
+        frames.append(Frame(index=k, time=k / 25.0, image=img))
+    return frames
+
+
+def _boat_detector(image, **_):
+    """The box of a boat (10 × 4 px) moving 4 px a frame, at the frame's index."""
+    k = int(image[0, 0])
+    return np.array([[100.0 + 4.0 * k, 200.0, 10.0, 4.0]])
+
+
 def test_track_frames_coasts_over_frames_whose_index_skips():
     """``track_frames`` on ``Frame`` objects whose indices skip 30-34 (lost from the
     source): the same boat as above keeps one id, one output per frame given, and
     :func:`frames_lost` rounds index gaps to whole decimation steps."""
-    from seawatch.io.video import Frame
-
-    lost = range(30, 35)
-    frames = []
-    for k in (k for k in range(40) if k not in lost):
-        img = np.zeros((8, 8), np.uint8)
-        img[0, 0] = k
-        frames.append(Frame(index=k, time=k / 25.0, image=img))
-
-    def boat(image, **_):
-        k = int(image[0, 0])
-        return np.array([[100.0 + 4.0 * k, 200.0, 10.0, 4.0]])
-
-    vt = VisualTracker(detector=boat, horizon=False, motion=False)
+    frames = _numbered_frames(k for k in range(40) if k not in range(30, 35))
+    vt = VisualTracker(detector=_boat_detector, horizon=False, motion=False)
     out = vt.track_frames(frames, ahead=False)
     assert len(out) == len(frames)
     assert {int(i) for t in out for i in t[:, 0]} == {1}
@@ -147,20 +154,9 @@ def test_a_boat_seen_in_every_third_frame_is_tracked_from_its_third():
     frame given after (to 1 px; 4 px a frame, 12 px between frames given). Counted as
     frames without the boat (session 25's code), 3 of 5 was never reached and the boat
     was never tracked."""
-    from seawatch.io.video import Frame
-
-    frames = []
-    for k in range(0, 90, 3):
-        img = np.zeros((8, 8), np.uint8)
-        img[0, 0] = k
-        frames.append(Frame(index=k, time=k / 25.0, image=img))
-
-    def boat(image, **_):
-        k = int(image[0, 0])
-        return np.array([[100.0 + 4.0 * k, 200.0, 10.0, 4.0]])
-
+    frames = _numbered_frames(range(0, 90, 3))
     for name in ("afkf", "kf"):
-        vt = VisualTracker(detector=boat, filter=name, horizon=False, motion=False)
+        vt = VisualTracker(detector=_boat_detector, filter=name, horizon=False, motion=False)
         out = vt.track_frames(frames, ahead=False)
         assert [t.shape[0] for t in out[:4]] == [0, 0, 1, 1]
         assert {int(i) for t in out for i in t[:, 0]} == {1}
