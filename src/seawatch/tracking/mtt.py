@@ -51,7 +51,9 @@ image (pixels) or as points on the sea (metres). One scan:
    *confirmed* once it has M detections among its last N scans (M-of-N, counting its
    birth) and is deleted as soon as it can no longer reach M within its first N scans;
    a confirmed track is deleted after K consecutive misses (with ``coast_ratio`` r, also
-   once they reach r times its detections). Track ids are integers that are never
+   once they reach r times its detections). A scan not made (a frame lost or dropped,
+   ``step(None, observed=False)``) only predicts: it counts towards K but is no scan of
+   the M-of-N window nor a miss of the ratio. Track ids are integers that are never
    reused.
 
 Boxes ``(x, y, w, h)`` (top-left corner, width, height) are tracked by their centre;
@@ -150,8 +152,9 @@ class TrackStates:
             (px or m) and those units per time unit.
         covariances: state covariances, (k, 4, 4).
         confirmed: True for confirmed tracks, False for tentative ones, (k,).
-        misses: consecutive scans without a detection, (k,) int64 (0: updated in this
-            scan; a confirmed track with misses > 0 is coasting on its prediction).
+        misses: consecutive scans without a detection, scans not made included
+            (``step``'s ``observed``), (k,) int64 (0: updated in this scan; a confirmed
+            track with misses > 0 is coasting on its prediction).
         hits: detections assigned to the track so far, (k,) int64.
         detection: index of the detection (in this scan's input, NaN rows counted)
             that updated or started the track, -1 if none, (k,) int64.
