@@ -10,6 +10,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -503,6 +504,13 @@ def test_track_keep_up_drops_frames_it_is_behind_on_and_a_file_loses_none(clip, 
     shown = [round(float((t - pts[0]) * stream.time_base) * 25.0) for t in pts]  # frame 0 on
     assert len(shown) == doc["frames"] and np.all(np.diff(shown) > 0)
     assert tracked <= set(shown) and max(shown) < 80
+    # and read back by seawatch at the source's indices (the writer's rate tag: the
+    # stream's own rates are those of the gaps)
+    from seawatch.io.video import VideoReader, VideoWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", VideoWarning)  # the frames dropped: missing
+        assert [f.index for f in VideoReader(tmp_path / "out" / "annotated.mp4")] == shown
     run = track_video(clip / "video.mp4", tmp_path / "all", annotate=False, report=False)
     assert run.frames == 80 and run.frames_dropped == 0
     assert run.to_json()["frames_dropped"] == 0

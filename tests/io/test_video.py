@@ -193,6 +193,40 @@ def test_frames_written_at_their_pts_keep_their_times_across_gaps(tmp_path: Path
         assert np.mean(np.abs(_gray(f.image) - _gray(_pattern(f.index)))) < 3.0
 
 
+@pytest.mark.parametrize("fragmented", [False, True])
+def test_frames_written_at_every_third_pts_keep_the_source_indices(tmp_path: Path, fragmented):
+    """Every third frame written (a job that kept up with a camera three times faster
+    than itself, as the track job's annotated.mp4, whose MP4 is fragmented): the
+    stream's own rates are the gaps' — average 375/44, and FFmpeg's guess from the
+    timestamps 25/3 — so without the writer's rate tag (:data:`RATE_TAG`) the frames
+    were read back as indices 0, 1, 2 … With it: the source indices 0, 3, 6 … at their
+    times, and the frames between reported missing."""
+    from seawatch.io.video import RATE_TAG, _tagged_rate
+    from seawatch.report.annotate import FRAGMENTED_MP4
+
+    path = tmp_path / "every3.mp4"
+    opts = FRAGMENTED_MP4 if fragmented else None
+    with VideoWriter(path, fps=25.0, crf=0, container_options=opts) as writer:
+        for k in range(0, 90, 3):
+            writer.write(_pattern(k), pts=k)
+    with av.open(str(path)) as container:
+        assert container.metadata[RATE_TAG] == "25"
+        assert container.streams.video[0].guessed_rate == Fraction(25, 3)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        frames = list(VideoReader(path))
+    notes = [str(w.message) for w in caught if issubclass(w.category, VideoWarning)]
+    assert "2 frame(s) missing between 0.000 s and 0.120 s" in notes[0]
+    assert [f.index for f in frames] == list(range(0, 90, 3))
+    assert [f.time for f in frames] == pytest.approx([k / 25.0 for k in range(0, 90, 3)])
+    for f in frames:
+        assert np.mean(np.abs(_gray(f.image) - _gray(_pattern(f.index)))) < 3.0
+    assert _tagged_rate({RATE_TAG: "30000/1001"}) == pytest.approx(29.97003)
+    for bad in ("", "abc", "1/0", "0", "-25", "5000"):
+        assert _tagged_rate({RATE_TAG: bad}) is None
+    assert _tagged_rate({}) is None
+
+
 # ----------------------------------------------------------------------------- corruption
 def test_bytes_overwritten_mid_file_skip_and_count_frames_without_failing(
     clip: Path, tmp_path: Path

@@ -126,6 +126,9 @@ REALTIME_SCHEMES = (
 _URL = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*://")
 _MAX_WARNINGS = 10  # individual warnings per kind before they are summarised at the end
 _MAX_GAP_S = 10.0  # [s] longer forward timestamp jumps are discontinuities, not lost frames
+RATE_TAG = "seawatch_frame_rate"
+"""Container tag in which :class:`VideoWriter` stores its frame rate (a fraction, e.g.
+``"25"`` or ``"30000/1001"``), read back by :class:`VideoReader` as the file's rate."""
 RECONNECT_WAIT_MAX = 30.0
 """Longest wait between two attempts to reopen a dropped live source [s]."""
 
@@ -653,7 +656,9 @@ class VideoReader:
         ctx = stream.codec_context
         if ctx.width and ctx.height:
             self._size = (int(ctx.width), int(ctx.height))
-        self._rate = _nominal_rate(stream.average_rate, stream.guessed_rate)
+        self._rate = _tagged_rate(container.metadata) or _nominal_rate(
+            stream.average_rate, stream.guessed_rate
+        )
         self._count = int(stream.frames) if stream.frames else None
         return container
 
@@ -970,6 +975,16 @@ class _Log:
                 )
 
 
+def _tagged_rate(metadata: Any) -> float | None:
+    """The frame rate a :class:`VideoWriter` stored in the container (:data:`RATE_TAG`)
+    [frames/s], or None (no tag, or not a rate in (0, 1000))."""
+    try:
+        rate = float(Fraction(str(metadata.get(RATE_TAG, ""))))
+    except (ValueError, ZeroDivisionError):
+        return None
+    return rate if 0.0 < rate < 1000.0 else None
+
+
 def _nominal_rate(average: Any, guessed: Any) -> float | None:
     """The stream's frame rate [frames/s]: its base rate (FFmpeg's r_frame_rate, PyAV's
     ``guessed_rate``) where the average rate (frames over duration) is up to a third
@@ -1015,7 +1030,11 @@ class VideoWriter:
     16-bit thermal video. ``yuv420p`` needs even sizes: an odd width or height is padded
     by one replicated column/row on the right/bottom (pixel coordinates are unchanged).
     MP4/MOV files are written with the index at the front (``+faststart``), so a file
-    cut short later still plays up to the cut.
+    cut short later still plays up to the cut. The frame rate is stored in the
+    container's tag :data:`RATE_TAG`: a file of frames written at gaps in time
+    (``pts``, frames dropped upstream) has an average rate below it, and FFmpeg's guess
+    of the rate from the timestamps is the gaps' (every third frame: 25/3), so
+    :class:`VideoReader` takes the tag for the frames' indices.
 
     Args:
         path: output file; its extension picks the container (``.mp4``, ``.mkv``, …).
@@ -1081,13 +1100,18 @@ class VideoWriter:
         self._deep = image.dtype == np.uint16
         rate = Fraction(self.fps).limit_denominator(100_000)
         fmt_opts = {}
-        if self.path.suffix.lower() in (".mp4", ".mov", ".m4v"):
+        mp4 = self.path.suffix.lower() in (".mp4", ".mov", ".m4v")
+        if mp4:
             fmt_opts["movflags"] = "+faststart"
         fmt_opts.update(self.container_options)
+        if mp4 and "use_metadata_tags" not in fmt_opts.get("movflags", ""):
+            # the MP4 muxer keeps tags it does not know, RATE_TAG, only with this flag
+            fmt_opts["movflags"] = fmt_opts.get("movflags", "") + "+use_metadata_tags"
         try:
             container = av.open(str(self.path), "w", options=fmt_opts)
         except (av.error.FFmpegError, OSError, ValueError) as exc:
             raise ValueError(f"path: cannot create video file {self.path} ({_why(exc)})") from None
+        container.metadata[RATE_TAG] = str(rate)
         codecs = [self.codec] if self._deep else [self.codec, "mpeg4"]
         stream = None
         last_error = ""
