@@ -547,8 +547,8 @@ class MultiTargetTracker:
                 but the scan is none of the evidence rules' scans — the M-of-N window
                 does not move, and ``coast_ratio`` counts only the misses of scans made.
                 A ship that was not looked for was not missed: with every other frame
-                dropped a new track still confirms on three detections, and a track is
-                not deleted for frames it was not looked for in.
+                dropped a new track still confirms on three detections, and the coast
+                ratio does not delete a young track for frames it was not looked for in.
 
         Returns:
             :class:`TrackStates` of every live track after this scan.
