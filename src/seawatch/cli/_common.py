@@ -218,32 +218,24 @@ def frame_records(
     names the first frame dropped. ``keep_up=None`` (default): when the reader's source
     is real-time (:attr:`seawatch.io.video.VideoReader.realtime`).
     """
+    from seawatch.io.prefetch import Skipped, prefetch
     from seawatch.io.video import VideoError
 
     records: list[dict[str, Any]] = []
     failure: Exception | None = None
-    from seawatch.io.prefetch import Skipped, prefetch
-
     late = Skipped()
     if keep_up is None:
         keep_up = bool(getattr(reader, "realtime", False))
     frames: Iterable[Any] = reader
     if keep_up:
         frames = prefetch(reader, name="seawatch-read", skip=late)
-    warned = False
     sink, writer = open_csv(output, columns)
     try:
         with progress_bar() as bar:
             task = bar.add_task(label, total=reader.expected_frames)
             try:
                 for frame in frames:
-                    if late.count and not warned:
-                        warnings.warn(
-                            f"frame {late.first}: processing is behind the source; "
-                            "frames are dropped to keep up with it",
-                            stacklevel=2,
-                        )
-                        warned = True
+                    late.warn_once()
                     rec = process(frame)
                     records.append(rec)
                     if writer is not None and sink is not None:

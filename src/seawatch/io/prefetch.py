@@ -12,6 +12,7 @@ from __future__ import annotations
 import queue
 import threading
 import time
+import warnings
 from collections.abc import Callable, Iterable, Iterator
 from typing import Any, TypeVar
 
@@ -33,11 +34,24 @@ class Skipped:
     def __init__(self) -> None:
         self.count = 0
         self.first: Any = None
+        self._warned = False
 
     def __call__(self, item: Any) -> None:
         if self.first is None:
             self.first = getattr(item, "index", "?")
         self.count += 1
+
+    def warn_once(self, consequence: str = "", stacklevel: int = 2) -> None:
+        """Warn, once and only after an item was skipped, that the consumer is behind
+        its source and frames are dropped (naming the first); ``consequence`` is
+        appended to the message, ``stacklevel`` is that of the caller's own warning."""
+        if self.count and not self._warned:
+            self._warned = True
+            warnings.warn(
+                f"frame {self.first}: processing is behind the source; frames are dropped "
+                f"to keep up with it{consequence}",
+                stacklevel=stacklevel + 1,
+            )
 
 
 def prefetch(

@@ -50,7 +50,6 @@ px, px, px, px, frames]; ``x, y`` is the box's top-left corner.
 
 from __future__ import annotations
 
-import warnings
 from collections import deque
 from collections.abc import Iterable, Iterator, Sequence
 from typing import Any, Literal
@@ -616,12 +615,7 @@ class VisualTracker:
         try:
             ready = prefetch(frames, work=horizon, name=READ_THREAD, skip=late if keep_up else None)
             for item in prefetch(ready, work=detect, name=DETECT_THREAD):
-                if late.count and not self.frames_dropped:
-                    warnings.warn(
-                        f"frame {late.first}: processing is behind the source; frames "
-                        "are dropped to keep up with it (their tracks coast)",
-                        stacklevel=2,
-                    )
+                late.warn_once(" (their tracks coast)", stacklevel=2)
                 self.frames_dropped = late.count
                 yield item
             self.frames_dropped = late.count
