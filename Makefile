@@ -68,6 +68,7 @@ results: $(VENV)/.installed-test
 	$(BIN)/python $(R)/track/measure.py --out out/track-targets
 	$(BIN)/python $(R)/detect/measure.py --out out/detect-mardct
 	$(BIN)/python $(R)/fvessel/measure.py
+	$(BIN)/python $(R)/live/drops.py
 	$(BIN)/seawatch bench video --repeats 3 --json > $(R)/bench/video.json
 	$(BIN)/seawatch bench mtt --json > $(R)/bench/mtt.json
 	$(BIN)/seawatch bench world --json > $(R)/bench/world.json
