@@ -852,6 +852,14 @@ class MultiTargetTracker:
         if sizes is not None:  # a box of another scale is another object (or a speck of it)
             area_t, area_d = np.prod(self._size[rows], axis=1), np.prod(sizes[cols], axis=1)
             gated &= _same_scale(area_t, area_d) | (area_t <= 0.0) | (area_d <= 0.0)
+            # a ship hidden behind another comes out at that ship's ends, under its own
+            # predicted box: a box clear of it is another ship, however wide the gate has
+            # grown while it coasted
+            hid = self._hidden[rows] > 0
+            if hid.any():
+                reach = 0.5 * (self._size[rows[hid]] + sizes[cols[hid]])
+                clear = np.any(np.abs(z[cols[hid]] - pred[rows[hid]]) >= reach, axis=1)
+                gated[np.flatnonzero(hid)[clear]] = False
         if tracks is not None:
             gated &= tracks[rows]
         if dets is not None:
