@@ -32,10 +32,7 @@ image (pixels) or as points on the sea (metres). One scan:
    coming out from behind another). No free edge: the box's centre if its
    extent agrees with the track's size; on the vertical axis the bottom edge (the water
    line) for the nearest of the overlapping ships if it agrees with its predicted one;
-   else the pair is not used and the track coasts — except that a box whose free end
-   tells a track's columns while no edge tells its rows (a ship behind another, its bow
-   or stern showing beside it) measures the columns alone (the rows' variance
-   :data:`_UNMEASURED`, gated with one degree of freedom). Gating uses these centres, so of two
+   else the pair is not used and the track coasts. Gating uses these centres, so of two
    ships with one centre each takes the box of its own size; a track overlapping another
    (their predicted boxes, widened by the tolerance, overlap) also takes its edge of a
    merged box that went to the other, and is not restarted on a re-segmented box; a box
@@ -54,9 +51,7 @@ image (pixels) or as points on the sea (metres). One scan:
    *confirmed* once it has M detections among its last N scans (M-of-N, counting its
    birth) and is deleted as soon as it can no longer reach M within its first N scans;
    a confirmed track is deleted after K consecutive misses (with ``coast_ratio`` r, also
-   once they reach r times its detections; with ``hidden_after``, misses while it is
-   hidden behind a ship in front of it — its span within that ship's, which took a box —
-   do not count, up to ``hidden_after`` in a run). A scan not made (a frame lost or dropped,
+   once they reach r times its detections). A scan not made (a frame lost or dropped,
    ``step(None, observed=False)``) only predicts: it counts towards K but is no scan of
    the M-of-N window nor a miss of the ratio. Track ids are integers that are never
    reused.
@@ -118,9 +113,6 @@ def _same_scale(area_a: FloatArray, area_b: FloatArray) -> NDArray[np.bool_]:
 _EDGE_TOL = 0.15
 """Occlusion handling: a box edge within this fraction of a track's size (at least σ_z)
 of a span or an extent counts as on it (:meth:`MultiTargetTracker._tolerance`)."""
-_UNMEASURED = 1e12
-"""Variance [px² or m²] given to the axis of a measurement that the box does not tell
-(:meth:`MultiTargetTracker._update`): the update leaves that axis to the prediction."""
 _SETTLED_HITS = 25
 """Occlusion handling: detections after which a confirmed track's height is its ship's
 (a top that then rises while the water line stays is something behind the ship)."""
@@ -358,13 +350,6 @@ class MultiTargetTracker:
             a track whose box overlaps another's also takes its edge of a merged box
             assigned to the other, and is not restarted by the overlap stage. False
             (default): off.
-        hidden_after: with ``occlusion``, the misses of a confirmed track *hidden*
-            behind a ship in front — no box told where it is, and its predicted span
-            lies within (± the tolerance) the span of a confirmed track that took a box
-            this scan and whose water line (bottom edge) is lower by more than the
-            tolerance — do not count towards its deletion, up to this many in one run
-            of misses (module docstring, step 5): a ship that passes behind another
-            keeps its track and id. 0 (default): off.
         filter_options: extra keyword arguments for a filter class (see above).
     """
 
@@ -385,7 +370,6 @@ class MultiTargetTracker:
         overlap_gate: float | None = None,
         confirmed_first: bool = False,
         occlusion: bool = False,
-        hidden_after: int = 0,
         filter_options: dict[str, Any] | None = None,
         coast_ratio: float | None = None,
         sigma_z_rel: float = 0.0,
@@ -400,8 +384,6 @@ class MultiTargetTracker:
             self.gate = float(chi2.ppf(p, _DIM))
         else:
             self.gate = positive("gate_threshold", gate_threshold)
-        # the same gate for a one-axis measurement (an anchored track seen by one axis)
-        self._gate_axis = float(chi2.ppf(chi2.cdf(self.gate, _DIM), 1))
         self.confirm_n = integer("confirm_n", confirm_n, 1)
         self.confirm_m = integer("confirm_m", confirm_m, 1)
         if self.confirm_m > self.confirm_n:
@@ -418,7 +400,6 @@ class MultiTargetTracker:
         )
         self.confirmed_first = bool(confirmed_first)
         self.occlusion = bool(occlusion)
-        self.hidden_after = integer("hidden_after", hidden_after, 0)
         self.filter_options = dict(filter_options or {})
         self.H = position_measurement(_DIM, 2)
         self.R = self.sigma_z**2 * np.eye(_DIM)
@@ -476,7 +457,6 @@ class MultiTargetTracker:
         self._hits = np.empty(0, np.int64)
         self._misses = np.empty(0, np.int64)
         self._unseen = np.empty(0, np.int64)  # scans not made among the misses
-        self._hidden = np.empty(0, np.int64)  # misses hidden behind a ship in front
         self._confirmed = np.empty(0, bool)
         self._size = np.empty((0, 2))
         self._filters: list[TrackFilter] = []
@@ -649,10 +629,6 @@ class MultiTargetTracker:
         self._hits += assigned
         self._misses = np.where(assigned, 0, self._misses + 1)
         self._unseen = np.where(assigned, 0, self._unseen)
-        if edges is not None and self.hidden_after:
-            self._hidden = np.where(assigned, 0, self._hidden + self._hidden_behind(assigned))
-        else:
-            self._hidden = np.where(assigned, 0, self._hidden)
         window_hits = _popcount(self._history)
         newly = ~self._confirmed & (window_hits >= self.confirm_m)
         self._confirmed |= newly
@@ -661,8 +637,7 @@ class MultiTargetTracker:
         if self.coast_ratio is not None:
             ratio = np.maximum(self.coast_ratio * self._hits, 1.0)
             limit = np.minimum(limit, ratio + self._unseen)  # the ratio: scans made only
-        counted = self._misses - np.minimum(self._hidden, self.hidden_after)
-        keep = np.where(self._confirmed, counted < limit, can_confirm) & ~dead
+        keep = np.where(self._confirmed, self._misses < limit, can_confirm) & ~dead
         self._compress(keep)
         detection = detection[keep]
         restarted = restarted[keep]
@@ -852,14 +827,6 @@ class MultiTargetTracker:
         if sizes is not None:  # a box of another scale is another object (or a speck of it)
             area_t, area_d = np.prod(self._size[rows], axis=1), np.prod(sizes[cols], axis=1)
             gated &= _same_scale(area_t, area_d) | (area_t <= 0.0) | (area_d <= 0.0)
-            # a ship hidden behind another comes out at that ship's ends, under its own
-            # predicted box: a box clear of it is another ship, however wide the gate has
-            # grown while it coasted
-            hid = self._hidden[rows] > 0
-            if hid.any():
-                reach = 0.5 * (self._size[rows[hid]] + sizes[cols[hid]])
-                clear = np.any(np.abs(z[cols[hid]] - pred[rows[hid]]) >= reach, axis=1)
-                gated[np.flatnonzero(hid)[clear]] = False
         if tracks is not None:
             gated &= tracks[rows]
         if dets is not None:
@@ -1098,13 +1065,6 @@ class MultiTargetTracker:
             dc,
             np.where(~blocked_lo, lo + 0.5 * s, np.where(~blocked_hi, hi - 0.5 * s, stuck)),
         )
-        # a box that does not tell the rows tells the columns only by a free end (a ship
-        # behind another, its bow or stern showing beside it); its extent or bottom where
-        # both ends are blocked may be the other ship's, and a free top (a mast, upper
-        # works boxed or not) does not tell the rows alone
-        part = np.isfinite(centre[:, 0]) & np.isnan(centre[:, 1])
-        centre[part & blocked_lo[:, 0] & blocked_hi[:, 0] & ~free[:, 0], 0] = np.nan
-        centre[np.isnan(centre[:, 0]), 1] = np.nan
         return centre, free
 
     def _anchor_pairs(
@@ -1175,53 +1135,14 @@ class MultiTargetTracker:
             t, best = t[ok], best[ok]
             if t.size:
                 za, _ = self._anchor_pairs(t, best, z, sizes)
-                inside = self._in_gate(t, za)
+                y = za - self._X[t] @ self.H.T
+                d2, _ = _mahalanobis2(self._innovation_covariance()[t], y)
+                inside = d2 <= self.gate  # False for NaN: the box does not tell
                 rows = np.concatenate([rows, t[inside]])
                 cols = np.concatenate([cols, best[inside]])
         zu, free = self._anchor_pairs(rows, cols, z, sizes)
-        # a box that tells neither axis: a miss; one axis: that axis is measured
-        told = np.any(np.isfinite(zu), axis=1)
+        told = np.all(np.isfinite(zu), axis=1)  # a box that does not tell: a miss
         return rows[told], cols[told], r2, c2, zu[told], free[told], np.flatnonzero(merged)
-
-    def _hidden_behind(self, assigned: NDArray[np.bool_]) -> NDArray[np.bool_]:
-        """Confirmed tracks without a detection this scan that are hidden behind a ship
-        in front (``hidden_after``): their predicted horizontal span lies within the
-        span of a confirmed track that took a box (both widened by the hidden track's
-        tolerance ``max(σ_z, 15 %)``), whose bottom edge (water line) is lower than
-        theirs by more than that tolerance, and which shares their rows."""
-        out = np.zeros(self.n_tracks, bool)
-        idle = np.flatnonzero(self._confirmed & ~assigned)
-        front = np.flatnonzero(self._confirmed & assigned)
-        if idle.size == 0 or front.size == 0:
-            return out
-        c, s = self._X[idle, :_DIM], self._size[idle]
-        oc, os_ = self._X[front, :_DIM], self._size[front]
-        tol = self._tolerance(s)[:, None]  # (i, 1, 2)
-        lo, hi = (c - 0.5 * s)[:, None], (c + 0.5 * s)[:, None]
-        olo, ohi = (oc - 0.5 * os_)[None], (oc + 0.5 * os_)[None]
-        t = tol[..., 0]
-        within = (lo[..., 0] >= olo[..., 0] - t) & (hi[..., 0] <= ohi[..., 0] + t)
-        nearer = ohi[..., 1] > hi[..., 1] + tol[..., 1]
-        rows_shared = np.minimum(hi[..., 1], ohi[..., 1]) > np.maximum(lo[..., 1], olo[..., 1])
-        out[idle] = np.any(within & nearer & rows_shared, axis=1)
-        return out
-
-    def _in_gate(self, rows: NDArray[np.int64], za: FloatArray) -> NDArray[np.bool_]:
-        """Whether the anchored centres ``za`` (:meth:`_anchor`) of tracks ``rows`` lie in
-        their gates: ``d² <= gamma`` on both axes, or, where the box tells one axis only
-        (the other NaN), ``y_k² / S_kk`` within the same gate for one degree of freedom.
-        A box that tells neither axis is in no gate."""
-        y = za - self._X[rows] @ self.H.T
-        S = self._innovation_covariance()[rows]
-        d2, _ = _mahalanobis2(S, y)
-        inside = d2 <= self.gate  # False for NaN
-        seen = np.isfinite(y)
-        one = seen.sum(axis=1) == 1
-        if one.any():
-            k = np.argmax(seen[one], axis=1)
-            idx = np.flatnonzero(one)
-            inside[one] = y[idx, k] ** 2 / S[idx, k, k] <= self._gate_axis
-        return inside
 
     def _restart(self, rows: NDArray[np.int64], z: FloatArray, sizes: FloatArray) -> None:
         """Restart tracks ``rows`` at detections ``z`` with their velocity and id kept:
@@ -1239,22 +1160,11 @@ class MultiTargetTracker:
             self._pull()
 
     def _update(self, rows: NDArray[np.int64], z: FloatArray) -> None:
-        """Kalman update of the assigned tracks (Joseph form), predict-only for the rest.
-        An axis of ``z`` that is NaN (a box that tells one axis of an anchored track) is
-        not measured: its innovation is zero and its variance :data:`_UNMEASURED`."""
-        R = self._noise(rows)
-        blind = ~np.isfinite(z)
-        if blind.any():
-            z = np.where(blind, self._X[rows] @ self.H.T, z)
-            R = np.array(np.broadcast_to(R, (rows.size, _DIM, _DIM)))
-            r, k = np.nonzero(blind)
-            R[r, k, :] = 0.0
-            R[r, :, k] = 0.0
-            R[r, k, k] = _UNMEASURED
+        """Kalman update of the assigned tracks (Joseph form), predict-only for the rest."""
         if self.batched:
             if rows.size == 0:
                 return
-            H = self.H
+            H, R = self.H, self._noise(rows)
             x = self._X[rows]
             P = self._P[rows]
             PHt = P @ H.T  # (a, 4, 2)
@@ -1267,17 +1177,14 @@ class MultiTargetTracker:
             self._P[rows] = 0.5 * (P + np.swapaxes(P, 1, 2))
             return
         zz: list[FloatArray | None] = [None] * len(self._filters)
-        Rs: list[FloatArray | None] = [None] * len(self._filters)
-        per_row = self.sigma_z_rel > 0.0 or blind.any()
         for i, r in enumerate(rows):
             zz[int(r)] = z[i]
-            if per_row:
-                Rs[int(r)] = R[i]
-        for f, zi, Ri in zip(self._filters, zz, Rs, strict=True):
-            if Ri is None or zi is None:
+        Rs = self._noise() if self.sigma_z_rel > 0.0 else None
+        for k, (f, zi) in enumerate(zip(self._filters, zz, strict=True)):
+            if Rs is None or zi is None:
                 f.update(zi)
             else:
-                f.update(zi, R=Ri)
+                f.update(zi, R=Rs[k])
         self._pull()
 
     def _compress(self, keep: NDArray[np.bool_]) -> None:
@@ -1291,7 +1198,6 @@ class MultiTargetTracker:
         self._hits = self._hits[keep]
         self._misses = self._misses[keep]
         self._unseen = self._unseen[keep]
-        self._hidden = self._hidden[keep]
         self._confirmed = self._confirmed[keep]
         self._size = self._size[keep]
         if self._filters:
@@ -1358,7 +1264,6 @@ class MultiTargetTracker:
         self._hits = np.concatenate([self._hits, ones])
         self._misses = np.concatenate([self._misses, np.zeros(k, np.int64)])
         self._unseen = np.concatenate([self._unseen, np.zeros(k, np.int64)])
-        self._hidden = np.concatenate([self._hidden, np.zeros(k, np.int64)])
         self._confirmed = np.concatenate([self._confirmed, np.full(k, self.confirm_m <= 1)])
         size = np.zeros((k, 2)) if sizes is None else sizes
         self._size = np.concatenate([self._size, size])

@@ -214,10 +214,6 @@ class VisualTracker:
             measured by the edges of its detection that lie outside the other ships'
             spans, with its remembered size (a box of both ships, a ship cut by the one
             in front); its water-line offset is then not updated.
-        hidden_after: with ``occlusion``, a confirmed track hidden behind a ship in front
-            (its span within the front ship's, its water line higher; no box tells
-            where it is) coasts up to this many frames more than ``delete_after`` and
-            the coast ratio allow: a ship that passes behind another keeps its track.
         min_score: detections with a lower score are ignored.
         horizon: estimate the horizon per frame and give it to the detector (sea region).
         stabilise: track the boxes in horizon-stabilised rows (module docstring); while
@@ -252,7 +248,6 @@ class VisualTracker:
         overlap_gate: float | None = 0.5,
         confirmed_first: bool = True,
         occlusion: bool = True,
-        hidden_after: int = 50,
         min_score: float = 0.0,
         horizon: bool = True,
         stabilise: bool = True,
@@ -296,7 +291,6 @@ class VisualTracker:
             overlap_gate=overlap_gate,
             confirmed_first=confirmed_first,
             occlusion=occlusion,
-            hidden_after=hidden_after,
             filter_options=opts or None,
             sigma_z_rel=sigma_z_rel,
         )
