@@ -979,30 +979,80 @@ def test_occlusion_a_settled_ship_keeps_its_width_behind_a_boat_at_its_end():
             assert st.boxes[a, 2][0] == pytest.approx(40.0, abs=0.5), k
 
 
-def test_a_ship_boxed_in_pieces_for_three_scans_is_one_track_again():
+def test_a_ship_boxed_in_pieces_from_its_first_scans_is_one_track_again():
     """A 56 × 13 px ship (moving 0.2 px a scan, centre noise 0.2 px) is boxed as two
-    pieces (38 and 17.5 px) in three scans: the small piece takes the ship's track and
-    the large one starts a second, and both are confirmed. Afterwards the ship's one box
-    is shared by the two tracks through their free edges (occlusion handling), and
-    before step 4b they kept the pieces' widths to the end: two boxes of 38 and 17.5 px
-    for one ship, 120 scans later. Now, 10 scans into the sharing (the box's width
-    unchanged), the track with more detections is restarted on the box and the other
-    deleted: one track, on the ship."""
+    pieces (38 and 17.5 px) in its first three scans, before any track is confirmed:
+    each piece starts a track and both are confirmed. Afterwards the ship's one box is
+    shared by the two tracks through their free edges (occlusion handling), and before
+    step 4b they kept the pieces' widths to the end: two boxes of 38 and 17.5 px for one
+    ship, 120 scans later. Now, 10 scans into the sharing (the box's width unchanged),
+    the track with more detections is restarted on the box and the other deleted: one
+    track, on the ship."""
     trk = _visual_tracker()
     rng = np.random.default_rng(0)
-    for k in range(160):
+    for k in range(140):
         x = 100.0 + 0.2 * k
-        if 40 <= k < 43:
+        if k < 3:
             z = np.array([[x, 200.0, 38.0, 13.0], [x + 38.5, 203.0, 17.5, 10.0]])
         else:
             z = np.array([[x, 200.0, 56.0, 13.0]])
         z[:, :2] += rng.normal(0.0, 0.2, (len(z), 2))
         conf = trk.step(z).confirmed_tracks()
-        if k == 45:
+        if k == 5:
             assert len(conf) == 2  # the pieces' tracks, both confirmed
-        if k >= 60:
+        if k >= 40:
             assert len(conf) == 1, (k, conf.boxes)
             assert np.all(np.abs(conf.boxes[0] - [x, 200.0, 56.0, 13.0]) < 1.0), (k, conf.boxes)
+
+
+@pytest.mark.parametrize("split", [(38.0, 0.5), (20.0, 1.0), (30.0, -1.0)])
+def test_a_tracked_ship_boxed_in_pieces_keeps_one_track_on_its_whole_box(split):
+    """A 56 × 13 px ship (moving 0.2 px a scan, centre noise 0.2 px), tracked alone, is
+    boxed as two pieces in six scans (a left piece of ``w`` px, a gap of ``gap`` px — a
+    negative gap: they overlap — and the rest, both down to the water line, the right
+    one lower at the top): the pieces lie within the track's predicted box and together
+    make up its width, so they are one box of the ship (step 1a). The track keeps the
+    ship's centre and width within 1 px in every scan and no piece starts a track of its
+    own. Before step 1a the larger piece took the track (its width shrinking towards it)
+    and the other started a second track, confirmed on the third split scan (crossing,
+    seed 0: a 15 × 5 px boat split in frames 161–172 kept a track 4 px too narrow for
+    30 frames)."""
+    w, gap = split
+    trk = _visual_tracker()
+    rng = np.random.default_rng(1)
+    for k in range(80):
+        x = 100.0 + 0.2 * k
+        if k in (40, 41, 43, 44, 46, 47):
+            rest = 56.0 - w - gap
+            z = np.array([[x, 200.0, w, 13.0], [x + w + gap, 203.0, rest, 10.0]])
+        else:
+            z = np.array([[x, 200.0, 56.0, 13.0]])
+        z[:, :2] += rng.normal(0.0, 0.2, (len(z), 2))
+        st = trk.step(z)
+        assert st.ids.tolist() == [1], (k, st.ids)
+        if k >= 3:
+            assert abs(st.states[0, 0] - (x + 28.0)) < 1.0, (k, st.states[0])
+            assert abs(st.boxes[0, 2] - 56.0) < 1.0, (k, st.boxes[0])
+
+
+def test_a_boat_seen_within_a_ship_s_box_is_no_piece_of_it():
+    """Step 1a unites only pieces that keep the ship's water line: a tracked 56 × 13 px
+    ship is boxed in two pieces for 20 scans while a distant 8 × 5 px boat is seen over
+    its low foredeck, within its box but with its water line 7 px higher. The hull's
+    pieces are one box of the ship; the boat is not one of them and gets a track of
+    its own."""
+    trk = _visual_tracker()
+    for k in range(40):
+        x = 100.0 + 0.2 * k
+        z = [[x, 200.0, 56.0, 13.0]]
+        if 10 <= k < 30:
+            z = [[x, 200.0, 38.0, 13.0], [x + 38.5, 200.0, 17.5, 13.0], [x + 4.0, 201.0, 8.0, 5.0]]
+        st = trk.step(np.array(z))
+        if 15 <= k < 30:
+            conf = st.confirmed_tracks()
+            assert len(conf) == 2, (k, conf.boxes)
+            assert np.all(np.abs(conf.boxes[0] - [x, 200.0, 56.0, 13.0]) < 1.0), (k, conf.boxes)
+            assert np.all(np.abs(conf.boxes[1] - [x + 4.0, 201.0, 8.0, 5.0]) < 1.0), k
 
 
 def test_two_ships_in_one_box_drifting_together_stay_two_tracks():

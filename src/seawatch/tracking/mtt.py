@@ -7,6 +7,12 @@ image (pixels) or as points on the sea (metres). One scan:
 
 1. **Predict** every track with its filter (nearly constant velocity model,
    ALGORITHMS.md §5.2: ``x = [x, y, vx, vy]``).
+1a. **A ship boxed in pieces** (boxes, ``occlusion``): two or more boxes that lie wholly
+   within one confirmed track's predicted box widened by its tolerance (and within no
+   other track's), keep its water line (their bottoms within the tolerance of its
+   predicted one) and together are no larger than the track plus its tolerance, while
+   none of them is the whole ship (as wide as the track less its tolerance), are one
+   box, their union: the track measures its whole ship, and a piece starts no track.
 2. **Gate** (Mahalanobis): ``d²_ij = y_ijᵀ S_i⁻¹ y_ij`` with ``y_ij = z_j − H x_i`` and
    ``S_i = H P_i Hᵀ + R_i``; detection j may update track i only if
    ``d²_ij <= gamma = chi2.ppf(gate_probability, 2)``. Vectorised over the candidate
@@ -568,13 +574,16 @@ class MultiTargetTracker:
                 )
         t = self._step_time(time)
         dt = self.dt if self._time is None else t - self._time
+
+        # 1. predict
+        self._predict(dt)
+        united = np.empty(0, np.int64)  # boxes made of one ship's pieces (step 1a)
+        if sizes is not None and self.occlusion and self._confirmed.any():
+            centres, sizes, repeat, united = self._unite_pieces(centres, sizes, repeat)
         valid = np.flatnonzero(np.all(np.isfinite(centres), axis=1))
         if sizes is not None:
             valid = valid[np.all(np.isfinite(sizes[valid]), axis=1)]
         z = centres[valid]
-
-        # 1. predict
-        self._predict(dt)
         # 2.–3. gate and assign
         boxes = sizes is not None and self.overlap_gate is not None
         zs = None if sizes is None else sizes[valid]
@@ -600,6 +609,7 @@ class MultiTargetTracker:
             occ = self._occlusion(rows, cols, r2, c2, z, zs)  # type: ignore[arg-type]
             rows, cols, r2, c2, zu, grow, explained = occ
             anchored[rows[~grow.all(axis=1)]] = True
+        anchored[rows[np.isin(valid[cols], united)]] = True  # no piece's water line
         assigned = np.zeros(self.n_tracks, bool)
         assigned[rows] = True
         self._S = None  # the update changes P
@@ -1202,6 +1212,57 @@ class MultiTargetTracker:
         self._size = self._size[keep]
         if self._filters:
             self._filters = [f for f, k in zip(self._filters, keep, strict=True) if k]
+
+    def _unite_pieces(
+        self, centres: FloatArray, sizes: FloatArray, stale: NDArray[np.bool_]
+    ) -> tuple[FloatArray, FloatArray, NDArray[np.bool_], NDArray[np.int64]]:
+        """Step 1a (module docstring): a ship boxed in pieces in this scan is one box.
+
+        Per confirmed track, the boxes (``centres`` ± ``sizes``/2) of this scan that lie
+        wholly within its predicted box (predicted centre, smoothed size) widened by its
+        tolerance ``max(σ_z, 15 %)`` on every side and within no other track's, and
+        whose bottoms lie within the tolerance of its predicted water line (a hull's
+        pieces; a boat seen beyond the ship over its deck is none): if two or more,
+        none as wide as the track less its tolerance (a box of the whole ship: the
+        others are something else), and their union no larger than the track plus its
+        tolerance on either axis, the largest of them becomes their union (stale only
+        if all were) and the others are dropped (NaN). So the track measures its whole
+        ship, and a piece starts no track of its own, which step 4b would merge again
+        only after it had taken an end of the ship's box in ten scans in a row (the
+        crossing case, seed 0: a 15 × 5 px boat boxed in two pieces now and then in
+        frames 161–172 kept a track 4 px too narrow for 30 frames). Returns the
+        centres, sizes and stale flags (copies) and the indices of the united boxes.
+
+        Hand-written: a rule of this tracker's occlusion handling, which no library has."""
+        ok = np.all(np.isfinite(centres), axis=1) & np.all(np.isfinite(sizes), axis=1)
+        idx = np.flatnonzero(self._confirmed & np.all(self._size > 0.0, axis=1))
+        if idx.size == 0 or np.count_nonzero(ok) < 2:
+            return centres, sizes, stale, np.empty(0, np.int64)
+        c, s = self._X[idx, :_DIM], self._size[idx]
+        tol = self._tolerance(s)
+        lo, hi = c - 0.5 * s - tol, c + 0.5 * s + tol  # (k, 2) widened predicted boxes
+        d_lo, d_hi = centres - 0.5 * sizes, centres + 0.5 * sizes  # (D, 2)
+        inside = np.all((d_lo[None] >= lo[:, None]) & (d_hi[None] <= hi[:, None]), axis=2)
+        inside &= ok[None] & (np.count_nonzero(inside, axis=0) == 1)[None]  # one track's
+        # a piece of the hull keeps the ship's water line (its bottom within tolerance)
+        bottom = np.abs(d_hi[None, :, 1] - (c[:, None, 1] + 0.5 * s[:, None, 1]))
+        inside &= bottom <= tol[:, None, 1]
+        centres, sizes, stale = centres.copy(), sizes.copy(), stale.copy()
+        united = []
+        for k in np.flatnonzero(np.count_nonzero(inside, axis=1) >= 2):
+            pieces = np.flatnonzero(inside[k])
+            if np.any(sizes[pieces, 0] >= s[k, 0] - tol[k, 0]):
+                continue  # one of them is the whole ship
+            u_lo, u_hi = d_lo[pieces].min(axis=0), d_hi[pieces].max(axis=0)
+            if np.any(u_hi - u_lo > s[k] + tol[k]):
+                continue
+            big = int(pieces[np.argmax(np.prod(sizes[pieces], axis=1))])
+            centres[big], sizes[big] = 0.5 * (u_lo + u_hi), u_hi - u_lo
+            stale[big] = bool(stale[pieces].all())
+            rest = pieces[pieces != big]
+            centres[rest] = np.nan
+            united.append(big)
+        return centres, sizes, stale, np.asarray(united, np.int64)
 
     def _pieces_of_one(
         self,
