@@ -1022,7 +1022,7 @@ def test_a_tracked_ship_boxed_in_pieces_keeps_one_track_on_its_whole_box(split):
     rng = np.random.default_rng(1)
     for k in range(80):
         x = 100.0 + 0.2 * k
-        if k in (40, 41, 43, 44, 46, 47):
+        if k in (40, 41, 43, 44, 46, 47):  # two scans in a row at most (_SPLIT_SCANS)
             rest = 56.0 - w - gap
             z = np.array([[x, 200.0, w, 13.0], [x + w + gap, 203.0, rest, 10.0]])
         else:
@@ -1035,24 +1035,40 @@ def test_a_tracked_ship_boxed_in_pieces_keeps_one_track_on_its_whole_box(split):
             assert abs(st.boxes[0, 2] - 56.0) < 1.0, (k, st.boxes[0])
 
 
+def test_a_box_of_two_ships_that_comes_apart_for_good_becomes_two_tracks():
+    """Two ships side by side (30 and 25 px, one water line) are one 55-px box for ten
+    scans — one track — and then two boxes for good. Their boxes lie within the track's
+    and make up its width, like a hull's pieces, but pieces are united for two scans in
+    a row at most (:data:`_SPLIT_SCANS`) and not where a tentative track follows one:
+    the second ship's track is confirmed by the sixth scan apart and both are then
+    tracked on their own boxes."""
+    trk = _visual_tracker()
+    for k in range(30):
+        x = 100.0 + 0.2 * k
+        if k < 10:
+            z = np.array([[x, 200.0, 55.0, 12.0]])
+        else:
+            z = np.array([[x, 200.0, 30.0, 12.0], [x + 29.0, 200.5, 26.0, 11.5]])
+        conf = trk.step(z).confirmed_tracks()
+        if k >= 15:
+            assert len(conf) == 2, (k, conf.boxes)
+    np.testing.assert_allclose(np.sort(conf.states[:, 0]), [x + 15.0, x + 42.0], atol=1.0)
+
+
 def test_a_boat_seen_within_a_ship_s_box_is_no_piece_of_it():
     """Step 1a unites only pieces that keep the ship's water line: a tracked 56 × 13 px
-    ship is boxed in two pieces for 20 scans while a distant 8 × 5 px boat is seen over
+    ship is boxed in two pieces in one scan while a distant 8 × 5 px boat is seen over
     its low foredeck, within its box but with its water line 7 px higher. The hull's
-    pieces are one box of the ship; the boat is not one of them and gets a track of
-    its own."""
+    pieces are one box of the ship; the boat is not one of them and starts a track."""
     trk = _visual_tracker()
-    for k in range(40):
-        x = 100.0 + 0.2 * k
-        z = [[x, 200.0, 56.0, 13.0]]
-        if 10 <= k < 30:
-            z = [[x, 200.0, 38.0, 13.0], [x + 38.5, 200.0, 17.5, 13.0], [x + 4.0, 201.0, 8.0, 5.0]]
-        st = trk.step(np.array(z))
-        if 15 <= k < 30:
-            conf = st.confirmed_tracks()
-            assert len(conf) == 2, (k, conf.boxes)
-            assert np.all(np.abs(conf.boxes[0] - [x, 200.0, 56.0, 13.0]) < 1.0), (k, conf.boxes)
-            assert np.all(np.abs(conf.boxes[1] - [x + 4.0, 201.0, 8.0, 5.0]) < 1.0), k
+    for k in range(10):
+        trk.step(np.array([[100.0 + 0.2 * k, 200.0, 56.0, 13.0]]))
+    x = 102.0
+    boat = [x + 4.0, 201.0, 8.0, 5.0]
+    st = trk.step(np.array([[x, 200.0, 38.0, 13.0], [x + 38.5, 200.0, 17.5, 13.0], boat]))
+    assert st.ids.tolist() == [1, 2]
+    np.testing.assert_allclose(st.boxes[0], [x, 200.0, 56.0, 13.0], atol=0.5)
+    np.testing.assert_allclose(st.boxes[1], boat)
 
 
 def test_two_ships_in_one_box_drifting_together_stay_two_tracks():

@@ -13,6 +13,8 @@ image (pixels) or as points on the sea (metres). One scan:
    predicted one) and together are no larger than the track plus its tolerance, while
    none of them is the whole ship (as wide as the track less its tolerance), are one
    box, their union: the track measures its whole ship, and a piece starts no track.
+   Not where a tentative track follows one of them (IoU ≥ 1/2), nor past two scans in
+   a row (:data:`_SPLIT_SCANS`): a box of two ships that comes apart for good is two.
 2. **Gate** (Mahalanobis): ``d²_ij = y_ijᵀ S_i⁻¹ y_ij`` with ``y_ij = z_j − H x_i`` and
    ``S_i = H P_i Hᵀ + R_i``; detection j may update track i only if
    ``d²_ij <= gamma = chi2.ppf(gate_probability, 2)``. Vectorised over the candidate
@@ -125,6 +127,9 @@ _SETTLED_HITS = 25
 _PIECES_SCANS = 10
 """Occlusion handling: scans in a row in which two tracks take the free edges of one box
 of an unchanging width before they are taken for one ship's pieces (step 4b)."""
+_SPLIT_SCANS = 2
+"""Occlusion handling: scans in a row in which a track's box may come in pieces that are
+united (step 1a); pieces that last longer are two ships (a box of two that comes apart)."""
 _UNGATED = 1.0e12  # cost of a pair outside the gate inside the assignment solver
 
 
@@ -463,6 +468,7 @@ class MultiTargetTracker:
         self._hits = np.empty(0, np.int64)
         self._misses = np.empty(0, np.int64)
         self._unseen = np.empty(0, np.int64)  # scans not made among the misses
+        self._split = np.empty(0, np.int64)  # scans in a row boxed in pieces (step 1a)
         self._confirmed = np.empty(0, bool)
         self._size = np.empty((0, 2))
         self._filters: list[TrackFilter] = []
@@ -580,6 +586,8 @@ class MultiTargetTracker:
         united = np.empty(0, np.int64)  # boxes made of one ship's pieces (step 1a)
         if sizes is not None and self.occlusion and self._confirmed.any():
             centres, sizes, repeat, united = self._unite_pieces(centres, sizes, repeat)
+        else:
+            self._split[:] = 0
         valid = np.flatnonzero(np.all(np.isfinite(centres), axis=1))
         if sizes is not None:
             valid = valid[np.all(np.isfinite(sizes[valid]), axis=1)]
@@ -1208,6 +1216,7 @@ class MultiTargetTracker:
         self._hits = self._hits[keep]
         self._misses = self._misses[keep]
         self._unseen = self._unseen[keep]
+        self._split = self._split[keep]
         self._confirmed = self._confirmed[keep]
         self._size = self._size[keep]
         if self._filters:
@@ -1230,13 +1239,18 @@ class MultiTargetTracker:
         ship, and a piece starts no track of its own, which step 4b would merge again
         only after it had taken an end of the ship's box in ten scans in a row (the
         crossing case, seed 0: a 15 × 5 px boat boxed in two pieces now and then in
-        frames 161–172 kept a track 4 px too narrow for 30 frames). Returns the
-        centres, sizes and stale flags (copies) and the indices of the united boxes.
+        frames 161–172 kept a track 4 px too narrow for 30 frames). A box that a
+        tentative track follows (IoU ≥ 1/2 with its predicted box) is none of the
+        pieces, and a track's boxes are united in :data:`_SPLIT_SCANS` scans in a row
+        at most: a track born on a box of two ships side by side (meeting) would
+        otherwise never let the second ship start its own. Returns the centres, sizes
+        and stale flags (copies) and the indices of the united boxes.
 
         Hand-written: a rule of this tracker's occlusion handling, which no library has."""
         ok = np.all(np.isfinite(centres), axis=1) & np.all(np.isfinite(sizes), axis=1)
         idx = np.flatnonzero(self._confirmed & np.all(self._size > 0.0, axis=1))
         if idx.size == 0 or np.count_nonzero(ok) < 2:
+            self._split[:] = 0
             return centres, sizes, stale, np.empty(0, np.int64)
         c, s = self._X[idx, :_DIM], self._size[idx]
         tol = self._tolerance(s)
@@ -1244,11 +1258,19 @@ class MultiTargetTracker:
         d_lo, d_hi = centres - 0.5 * sizes, centres + 0.5 * sizes  # (D, 2)
         inside = np.all((d_lo[None] >= lo[:, None]) & (d_hi[None] <= hi[:, None]), axis=2)
         inside &= ok[None] & (np.count_nonzero(inside, axis=0) == 1)[None]  # one track's
+        young = np.flatnonzero(~self._confirmed)
+        if young.size:  # a box that a tentative track follows (IoU >= 1/2) is that track's
+            area_t = np.prod(self._size[young], axis=1)[:, None]
+            inter = self._overlaps(young, centres, sizes, of_track=True) * area_t
+            with np.errstate(invalid="ignore", divide="ignore"):
+                iou = inter / (area_t + np.prod(sizes, axis=1)[None] - inter)
+            inside &= ~np.any(np.nan_to_num(iou) >= 0.5, axis=0)[None]
         # a piece of the hull keeps the ship's water line (its bottom within tolerance)
         bottom = np.abs(d_hi[None, :, 1] - (c[:, None, 1] + 0.5 * s[:, None, 1]))
         inside &= bottom <= tol[:, None, 1]
         centres, sizes, stale = centres.copy(), sizes.copy(), stale.copy()
         united = []
+        split = np.zeros(self.n_tracks, bool)
         for k in np.flatnonzero(np.count_nonzero(inside, axis=1) >= 2):
             pieces = np.flatnonzero(inside[k])
             if np.any(sizes[pieces, 0] >= s[k, 0] - tol[k, 0]):
@@ -1256,12 +1278,16 @@ class MultiTargetTracker:
             u_lo, u_hi = d_lo[pieces].min(axis=0), d_hi[pieces].max(axis=0)
             if np.any(u_hi - u_lo > s[k] + tol[k]):
                 continue
+            split[idx[k]] = True
+            if self._split[idx[k]] >= _SPLIT_SCANS:
+                continue  # pieces that last: two ships, each to start its own track
             big = int(pieces[np.argmax(np.prod(sizes[pieces], axis=1))])
             centres[big], sizes[big] = 0.5 * (u_lo + u_hi), u_hi - u_lo
             stale[big] = bool(stale[pieces].all())
             rest = pieces[pieces != big]
             centres[rest] = np.nan
             united.append(big)
+        self._split = np.where(split, self._split + 1, 0)
         return centres, sizes, stale, np.asarray(united, np.int64)
 
     def _pieces_of_one(
@@ -1325,6 +1351,7 @@ class MultiTargetTracker:
         self._hits = np.concatenate([self._hits, ones])
         self._misses = np.concatenate([self._misses, np.zeros(k, np.int64)])
         self._unseen = np.concatenate([self._unseen, np.zeros(k, np.int64)])
+        self._split = np.concatenate([self._split, np.zeros(k, np.int64)])
         self._confirmed = np.concatenate([self._confirmed, np.full(k, self.confirm_m <= 1)])
         size = np.zeros((k, 2)) if sizes is None else sizes
         self._size = np.concatenate([self._size, size])
