@@ -923,6 +923,15 @@ class MultiTargetTracker:
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.where(smaller > 0.0, inter / smaller, 0.0)
 
+    def _iou(self, tracks: NDArray[np.int64], dc: FloatArray, ds: FloatArray) -> FloatArray:
+        """Intersection over union of the predicted boxes of ``tracks`` (predicted
+        centres, smoothed sizes) with the boxes ``dc`` ± ``ds``/2, (k, D); 0 where
+        undefined (an empty box, a NaN row)."""
+        area = np.prod(self._size[tracks], axis=1)[:, None]
+        inter = self._overlaps(tracks, dc, ds, of_track=True) * area
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.nan_to_num(inter / (area + np.prod(ds, axis=1)[None] - inter))
+
     def _own_boxes(self, z: FloatArray, sizes: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Per track, the box of this scan that is its own — the one with the largest
         IoU with its predicted box, if that is 1/2 or more — as centre and size [px or
@@ -931,11 +940,7 @@ class MultiTargetTracker:
         s = np.full((self.n_tracks, _DIM), np.nan)
         if self.n_tracks == 0 or z.shape[0] == 0:
             return c, s
-        area = np.prod(self._size, axis=1)[:, None]
-        inter = self._overlaps(np.arange(self.n_tracks), z, sizes, of_track=True) * area
-        with np.errstate(invalid="ignore", divide="ignore"):
-            iou = inter / (area + np.prod(sizes, axis=1)[None] - inter)
-        iou = np.nan_to_num(iou)
+        iou = self._iou(np.arange(self.n_tracks), z, sizes)
         best = np.argmax(iou, axis=1)
         ok = iou[np.arange(self.n_tracks), best] >= 0.5
         c[ok], s[ok] = z[best[ok]], sizes[best[ok]]
@@ -1260,11 +1265,7 @@ class MultiTargetTracker:
         inside &= ok[None] & (np.count_nonzero(inside, axis=0) == 1)[None]  # one track's
         young = np.flatnonzero(~self._confirmed)
         if young.size:  # a box that a tentative track follows (IoU >= 1/2) is that track's
-            area_t = np.prod(self._size[young], axis=1)[:, None]
-            inter = self._overlaps(young, centres, sizes, of_track=True) * area_t
-            with np.errstate(invalid="ignore", divide="ignore"):
-                iou = inter / (area_t + np.prod(sizes, axis=1)[None] - inter)
-            inside &= ~np.any(np.nan_to_num(iou) >= 0.5, axis=0)[None]
+            inside &= ~np.any(self._iou(young, centres, sizes) >= 0.5, axis=0)[None]
         # a piece of the hull keeps the ship's water line (its bottom within tolerance)
         bottom = np.abs(d_hi[None, :, 1] - (c[:, None, 1] + 0.5 * s[:, None, 1]))
         inside &= bottom <= tol[:, None, 1]
