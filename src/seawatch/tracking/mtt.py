@@ -584,10 +584,8 @@ class MultiTargetTracker:
         # 1. predict
         self._predict(dt)
         united = np.empty(0, np.int64)  # boxes made of one ship's pieces (step 1a)
-        if sizes is not None and self.occlusion and self._confirmed.any():
+        if sizes is not None and self.occlusion:
             centres, sizes, repeat, united = self._unite_pieces(centres, sizes, repeat)
-        else:
-            self._split[:] = 0
         valid = np.flatnonzero(np.all(np.isfinite(centres), axis=1))
         if sizes is not None:
             valid = valid[np.all(np.isfinite(sizes[valid]), axis=1)]
