@@ -69,22 +69,26 @@ def detect_video(
     tracker: VisualTracker | None = None,
     offsets: list[np.ndarray] | None = None,
     horizons: list[Any] | None = None,
+    zooms: list[np.ndarray] | None = None,
 ) -> list[np.ndarray]:
     """Per-frame detections (k, 7) of a video (horizon + detector of ``tracker``); with a
     list ``offsets``, each frame's camera offset is appended to it
     (:meth:`VisualTracker.next_offset`), with a list ``horizons`` its horizon
-    (:meth:`VisualTracker.next_horizon`)."""
+    (:meth:`VisualTracker.next_horizon`), with a list ``zooms`` its camera zoom
+    (:meth:`VisualTracker.next_zoom`)."""
     vt = tracker if tracker is not None else VisualTracker()
     vt.reset()
     out = []
     with VideoReader(video) as reader:
         for _, _, det in vt.stream(reader):
             out.append(det)
-            offset, line = vt.next_offset(), vt.next_horizon()
+            offset, line, zoom = vt.next_offset(), vt.next_horizon(), vt.next_zoom()
             if offsets is not None:
                 offsets.append(offset)
             if horizons is not None:
                 horizons.append(line)
+            if zooms is not None:
+                zooms.append(zoom)
     return out
 
 
@@ -94,12 +98,14 @@ def track_case(
     filter: str,
     offsets: Sequence[np.ndarray] | None = None,
     horizons: Sequence[Any] | None = None,
+    zooms: Sequence[np.ndarray] | None = None,
     **options: Any,
 ) -> CLEResult:
     """CLE (§1.6) of :class:`VisualTracker` with ``filter`` on precomputed detections
-    (and the frames' camera ``offsets`` and ``horizons``, :func:`detect_video`)."""
+    (and the frames' camera ``offsets``, ``horizons`` and ``zooms``,
+    :func:`detect_video`)."""
     vt = VisualTracker(detector=_no_detector, filter=filter, horizon=False, **options)  # type: ignore[arg-type]
-    tracks = vt.track_detections(detections, offsets, horizons)
+    tracks = vt.track_detections(detections, offsets, horizons, zooms)
     return centre_location_error(tracks_to_rows(tracks), truth)
 
 
@@ -204,15 +210,17 @@ def _unit(
     detector = ClassicalShipDetector(polarity=polarity)  # type: ignore[arg-type]
     offsets: list[np.ndarray] = []
     lines: list[Any] = []
-    dets = detect_video(res.video, VisualTracker(detector=detector, fps=fps), offsets, lines)
+    zooms: list[np.ndarray] = []
+    vt = VisualTracker(detector=detector, fps=fps)
+    dets = detect_video(res.video, vt, offsets, lines, zooms)
     truth = read_truth(res.truth)
     rows: list[tuple[str, float | None, float, float, float]] = []
     for est in FILTERS:
-        c = track_case(dets, truth, est, offsets, lines)
+        c = track_case(dets, truth, est, offsets, lines, zooms)
         rows.append((est, None, c.mean_px, c.mean_percent, c.precision))
     if name == SWEEP_CASE:
         for a in orders:
-            c = track_case(dets, truth, "afkf", offsets, lines, order=a)
+            c = track_case(dets, truth, "afkf", offsets, lines, zooms, order=a)
             rows.append(("afkf", a, c.mean_px, c.mean_percent, c.precision))
     return {"run": r, "case": name, "crf": crf, "polarity": polarity, "rows": rows}
 

@@ -388,6 +388,7 @@ class MultiTargetTracker:
         self.dt = positive("dt", dt)
         self.sigma_a = axis_sigmas(_DIM, sigma_a, "sigma_a")
         self.sigma_z = positive("sigma_z", sigma_z)
+        self._sigma_z_given = self.sigma_z  # [detector px] (set_pixel_size)
         self.sigma_v0 = positive("sigma_v0", sigma_v0)
         self.sigma_z_rel = positive("sigma_z_rel", sigma_z_rel, allow_zero=True)
         if gate_threshold is None:
@@ -455,6 +456,19 @@ class MultiTargetTracker:
         if opts:
             raise ValueError("filter_options: only for filter classes, not for a factory")
         return factory
+
+    def set_pixel_size(self, pixel: float) -> None:
+        """The size of a detector's pixel in the tracker's coordinates for the scans to
+        come (1 at the start): ``sigma_z``, the measurement noise floor given in the
+        detector's pixels, is ``pixel`` times it there, in ``R``, the new tracks' ``P0``,
+        the gates and the edge tolerances. A zooming camera's boxes, tracked at the
+        first frame's focal length (:class:`~seawatch.vision.tracker.VisualTracker`),
+        are measured on a grid ``1 / zoom`` times as coarse. The tracks' filters keep
+        their own ``R`` only where ``sigma_z_rel`` is 0 (the per-scan ``R`` replaces it
+        otherwise)."""
+        self.sigma_z = self._sigma_z_given * positive("pixel", pixel)
+        self.R = self.sigma_z**2 * np.eye(_DIM)
+        self.P0 = np.diag([self.sigma_z**2] * _DIM + [self.sigma_v0**2] * _DIM)
 
     def reset(self, *, keep_ids: bool = False) -> None:
         """Forget all tracks and the last scan time; ids restart at 1, or with

@@ -1,4 +1,5 @@
-"""Camera motion between frames: the sideways image shift of a panning or yawing camera.
+"""Camera motion between frames: the sideways shift of a panning or yawing camera, and the
+zoom of a camera that changes its focal length.
 
 Issue 6, "a swaying or panning camera". A ship tracked in pixels moves with the camera as
 well as over the sea: a pan of ±4° in 3 s moves a 960-px, 60° view by up to 5 px a frame,
@@ -48,6 +49,31 @@ moving-platform clips, 0.16 (median) on the night case's grain, whose weak peaks
 anywhere (±20 px; with 0.1 its fixed camera wandered 175 px in 8 s and its CLE went
 1.19 → 12.8 %). A cut, a blank frame or a clear sky gives no peak. On a fixed camera
 the offset stays 0 and the tracker is exactly the uncompensated one.
+
+Zoom (a PTZ camera changing its focal length, an EO sight zooming in on a contact): the
+frame is magnified by ``s`` about its centre ``c`` from one frame to the next, so a
+point moves by ``(s − 1)(p − c)``, away from the centre or towards it. The real MarDCT
+ir-3 clip (``../shared/data/mardct_ir3/``) zooms out by 5–8 % a frame for its first 13
+frames: the boat, nearly still on the sea, crosses 150 px of the frame, and stops dead
+when the zoom does. The scale is measured as the difference of the horizontal shifts of
+the sky band's left and right halves, ``s − 1 = (d_right − d_left) / (W/2)`` (their
+centres lie half the band's width apart), refined by warping the earlier band with the
+scale found and measuring the halves again until the change is under 0.1 % (at most
+three rounds); the shift is then the whole band's against the warped one. On that clip
+it gives the scales a search over ``s`` in steps of 0.25 % finds (phase-correlation peak
+at its best) to 0.3–1.7 %, and 0.02–0.3 % on its still frames; on the rendered fixed
+cameras 0.03–0.04 % (median; at most 0.23 %). A Fourier–Mellin registration (log-polar
+magnitude spectra, the textbook method) was tried first: on the clip's zooming frames it
+gave scales within 0.4 % of 1 but one of 10.5, with peaks of 0.08–0.57. Both halves'
+peaks must reach ``min_response``. A zoom starts when two frames in a row change the
+scale the same way by ``gate_zoom`` or more (the scale's noise is far below it, and a
+zoom seldom lasts the window's frames: the clip's 13 frames would lose five) and goes on
+while the mean ``|ln s|`` of the window is at least half of it; unlike a pan's, a zoom's
+steps are not smoothed by the window's median, as a zoom lens stops dead. The zoom is
+accumulated in ``scale`` and taken out about the frame's centre ``c``: the frame's pixel
+``p`` is ``c + (p − c) / scale`` at the first frame's focal length, and the pan's
+``offset`` is added up there (a shift ``d`` measured at ``scale`` is ``d / scale`` of
+it). Without a zoom ``scale`` is 1 and everything is as above.
 """
 
 from __future__ import annotations
@@ -67,6 +93,9 @@ MIN_SKY = 0.08
 """Least part of the frame height above the horizon (less its margin) to measure on."""
 _MARGIN = 0.02  # [of the height] left out above the horizon: ships' upper works
 _JUMP_PX = 2.0  # [px a frame] farthest a pan's shift lies from the window's median
+_ZOOM_START = 2  # steps in a row beyond ``gate_zoom`` that start a zoom
+_ZOOM_ROUNDS = 3  # most rounds of the scale's refinement (module docstring)
+_ZOOM_DONE = 1e-3  # a round that changes the scale by less ends the refinement
 
 
 class CameraMotion:
@@ -79,12 +108,21 @@ class CameraMotion:
         gate_px: least median shift [px per frame] that starts a pan (half of it, as
             the mean shift size, keeps it going).
         min_response: least phase-correlation peak of a shift that is used (0–1).
+        gate_zoom: least median ``|ln s|`` of a frame's scale change that starts a zoom
+            (0.005: a zoom of 0.5 % a frame, 2× in 5.6 s at 25 frames/s); half of it, as
+            the mean, keeps it going.
 
     Attributes:
         offset: the accumulated shift (x, y) [px]: the current frame's content lies at
-            ``pixel - offset`` in the first frame's coordinates (y: 0, module docstring).
+            ``centre + (pixel - centre) / scale - offset`` in the first frame's
+            coordinates (y: 0, module docstring).
+        scale: the accumulated zoom: a length in the first frame is ``scale`` times
+            as long in the current one (1 for a camera that does not zoom).
+        centre: the frame's centre (x, y) [px] about which it zooms.
         shift: the last frame's measured shift (x, y) [px] (0 when unknown).
-        moving: whether the last frame counted as camera motion.
+        zoom: the last frame's measured scale change s (1 when unknown).
+        moving: whether the last frame counted as a pan.
+        zooming: whether the last frame counted as a zoom.
     """
 
     def __init__(
@@ -93,22 +131,29 @@ class CameraMotion:
         window: int = 9,
         gate_px: float = 0.5,
         min_response: float = 0.5,
+        gate_zoom: float = 0.005,
     ) -> None:
         self.width = integer("width", width, 16)
         self.window = integer("window", window, 1)
         self.gate_px = positive("gate_px", gate_px, allow_zero=True)
         self.min_response = positive("min_response", min_response, allow_zero=True)
+        self.gate_zoom = positive("gate_zoom", gate_zoom, allow_zero=True)
         self.reset()
 
     def reset(self) -> None:
-        """Forget the previous frame and the offset (a new video)."""
+        """Forget the previous frame, the offset and the scale (a new video)."""
         self.offset = np.zeros(2)
+        self.scale = 1.0
+        self.centre = np.zeros(2)
         self.shift = np.zeros(2)
+        self.zoom = 1.0
         self.moving = False
+        self.zooming = False
         self._prev: FloatArray | None = None
         self._prev_shape: tuple[int, ...] | None = None
         self._shifts: deque[float] = deque(maxlen=self.window)  # as measured
         self._steps: deque[float] = deque(maxlen=self.window)  # odd peaks replaced
+        self._zooms: deque[float] = deque(maxlen=self.window)  # ln s, as measured
 
     def update(self, image: ArrayLike, horizon: Any = None) -> FloatArray:
         """Measure the next frame (in frame order) and return the offset (x, y) [px].
@@ -123,17 +168,41 @@ class CameraMotion:
         band = self._band(img, k, self._sky_rows(horizon, height, k))
         prev, prev_shape = self._prev, self._prev_shape
         self._prev, self._prev_shape = band, img.shape
+        self.centre = 0.5 * (np.array(img.shape[1::-1], float) - 1.0)  # [px]
         self.shift = np.zeros(2)
+        self.zoom = 1.0
         if prev is None or prev_shape != img.shape:
             self._shifts.clear()
             self._steps.clear()
-            self.moving = False
+            self._zooms.clear()
+            self.moving = self.zooming = False
             return self.offset.copy()
         rows = min(band.shape[0], prev.shape[0])
+        at = (self.centre - 0.5 * (k - 1)) / k  # the centre in the band's pixels
+        zoom = None  # the scale change measured (None: not measurable)
         if rows >= MIN_SKY * height:
             a, b = prev[:rows], band[:rows]
+            zoom = self._scale(a, b, at)
+        if zoom is None:  # a zoom goes on at its last step, else none is seen
+            zoom = float(np.exp(self._zooms[-1])) if self.zooming else 1.0
+        self._zooms.append(float(np.log(zoom)))
+        missed = 1.0  # the zoom of the frames before it started
+        if self.zooming:  # a zoom goes on while its steps are not small
+            self.zooming = float(np.mean(np.abs(self._zooms))) >= 0.5 * self.gate_zoom
+        else:  # and starts on two steps in a row beyond the gate, the same way
+            last = list(self._zooms)[-_ZOOM_START:]
+            self.zooming = len(last) == _ZOOM_START and (
+                min(last) >= self.gate_zoom or max(last) <= -self.gate_zoom
+            )
+            if self.zooming:
+                missed = float(np.exp(sum(last[:-1])))
+        if self.zooming:
+            self.zoom = zoom
+        if rows >= MIN_SKY * height:
+            if self.zoom != 1.0:  # the earlier band as the zoom leaves it
+                a = _magnify(a, self.zoom, at)
             hann = cv2.createHanningWindow(a.shape[::-1], cv2.CV_32F)  # 0.1 ms
-            self.shift[0] = self._register(a, b, hann) * k
+            self.shift[:] = np.multiply(self._register(a, b, hann), k)
         step = float(self.shift[0])
         self._shifts.append(step)
         typical = float(np.median(self._shifts))
@@ -145,17 +214,72 @@ class CameraMotion:
         else:  # and starts when most of the window's shifts say so, at least half of it
             enough = 2 * len(self._shifts) > self.window
             self.moving = enough and abs(typical) >= self.gate_px
-        if self.moving:
-            self.offset = self.offset + np.array([step, 0.0])
+        self.scale *= self.zoom * missed
+        # at the first frame's focal length (module docstring); the vertical shift only
+        # while zooming: the zoom's centre lies off the frame's
+        rise = float(self.shift[1]) if self.zoom != 1.0 else 0.0
+        if self.moving or rise:
+            self.offset = self.offset + np.array([step if self.moving else 0.0, rise]) / self.scale
         return self.offset.copy()
 
-    def _register(self, a: FloatArray, b: FloatArray, hann: FloatArray) -> float:
-        """Horizontal shift [px of ``a``] of ``b``'s content against ``a``'s by phase
-        correlation; 0 when its peak is under ``min_response``."""
-        (dx, dy), response = cv2.phaseCorrelate(a, b, hann)
+    def _scale(self, a: FloatArray, b: FloatArray, centre: FloatArray) -> float | None:
+        """The scale change s of ``b``'s content against ``a``'s about ``centre`` [px of
+        ``a``] from the horizontal shifts of the bands' halves (module docstring); None
+        when the last round's peaks are not both ``min_response`` or more (the first
+        round's are weak under a zoom: each half is stretched), or s is not within
+        (0.5, 2)."""
+        half = a.shape[1] // 2
+        if half < 8:
+            return None
+        hann = cv2.createHanningWindow((half, a.shape[0]), cv2.CV_32F)
+        s, warped = 1.0, a
+        for _ in range(_ZOOM_ROUNDS):
+            shifts, peaks = [], []
+            for part in (slice(0, half), slice(half, 2 * half)):
+                (dx, dy), response = _correlate(warped[:, part], b[:, part], hann)
+                if not (np.isfinite(dx) and np.isfinite(dy)):
+                    return None
+                shifts.append(dx)
+                peaks.append(response)
+            change = (shifts[1] - shifts[0]) / half  # the halves' centres: half apart
+            if abs(change) < _ZOOM_DONE:
+                break
+            s *= 1.0 + change
+            if not 0.5 < s < 2.0:
+                return None
+            warped = _magnify(a, s, centre)
+        if min(peaks) < self.min_response:
+            return None
+        if s != 1.0 and not self._vertical_agrees(warped, b, float(np.log(s))):
+            return 1.0
+        return float(s)
+
+    def _vertical_agrees(self, warped: FloatArray, b: FloatArray, log_s: float) -> bool:
+        """Whether the band's upper and lower halves, ``warped`` by the scale found,
+        shift alike in the vertical (within half of ``log_s`` as a scale over their
+        distance): a zoom magnifies the rows as it does the columns, while a camera
+        turning about a tilted axis (a boat's camera pitching as it yaws) or a sky
+        that is not at infinity widens the band's content alone (the rendered
+        uav-sea clip: 0.4–0.8 % a frame across for 60 frames, with the rows
+        0.2 % closer together). A half without a peak of ``min_response`` cannot
+        tell (MarDCT's upper half, an empty thermal sky: 0.02–0.3): it agrees."""
+        half = warped.shape[0] // 2
+        hann = cv2.createHanningWindow((warped.shape[1], half), cv2.CV_32F)
+        rises = []
+        for part in (slice(0, half), slice(half, 2 * half)):
+            (_, dy), response = _correlate(warped[part], b[part], hann)
+            if not (response >= self.min_response and np.isfinite(dy)):
+                return True
+            rises.append(dy)
+        return abs((rises[1] - rises[0]) / half) <= 0.5 * abs(log_s)
+
+    def _register(self, a: FloatArray, b: FloatArray, hann: FloatArray) -> tuple[float, float]:
+        """Shift (x, y) [px of ``a``] of ``b``'s content against ``a``'s by phase
+        correlation; (0, 0) when its peak is under ``min_response``."""
+        (dx, dy), response = _correlate(a, b, hann)
         if not (response >= self.min_response and np.isfinite(dx) and np.isfinite(dy)):
-            return 0.0
-        return float(dx)
+            return 0.0, 0.0
+        return float(dx), float(dy)
 
     def _sky_rows(self, horizon: Any, height: int, k: int) -> int:
         """Rows of the frame downscaled by ``k`` (``height`` rows) above the horizon's
@@ -184,3 +308,21 @@ class CameraMotion:
             part = cv2.resize(part, (width, rows), interpolation=cv2.INTER_AREA)
         g = np.asarray(part, dtype=np.float32)
         return np.where(np.isfinite(g), g, 0.0).astype(np.float32)
+
+
+def _magnify(image: FloatArray, s: float, centre: FloatArray) -> FloatArray:
+    """``image`` magnified by ``s`` about ``centre`` (x, y) [px], the same size (its
+    border mirrored)."""
+    cx, cy = float(centre[0]), float(centre[1])
+    m = np.float32([[s, 0.0, (1.0 - s) * cx], [0.0, s, (1.0 - s) * cy]])
+    size = (image.shape[1], image.shape[0])
+    return cv2.warpAffine(image, m, size, flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT)
+
+
+def _correlate(a: FloatArray, b: FloatArray, hann: FloatArray) -> tuple[tuple[float, float], float]:
+    """``cv2.phaseCorrelate(a, b, hann)`` on copies: OpenCV (5.0.0 here) multiplies its
+    inputs by the window in place (measured: a float32 array, whole or a view of its
+    rows, equals ``a · hann`` to the last bit afterwards). Until session 29 the band
+    kept for the next frame was so windowed, and windowed again there: on the
+    rendered pan clip from frame 39 on, where the sky band kept its height."""
+    return cv2.phaseCorrelate(a.copy(), b.copy(), hann)  # type: ignore[no-any-return]

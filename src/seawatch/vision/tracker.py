@@ -34,11 +34,15 @@ settled (:data:`LINE_SETTLE`) and where it follows the lines before it
 prediction. Until the first line is taken the rows are the frame's. (The project's own
 addition [NEW]: the seed tracks the box centre in the frame's pixels, §1.3.)
 
-With ``motion`` (default) a moving camera's image shift is taken out first
+With ``motion`` (default) a moving camera's image shift and zoom are taken out first
 (:class:`~seawatch.vision.motion.CameraMotion`, measured on each frame where its horizon
-is found): the tracker filters the boxes in the first frame's coordinates (pixel minus
-the accumulated shift) and reports them in the frame's own; a fixed camera accumulates no
-shift and is tracked as without it.
+is found): the tracker filters the boxes in the first frame's coordinates and reports
+them in the frame's own. A zoom is undone about the frame's centre ``c`` — a pixel ``p``
+is ``c + (p − c) / scale``, box sizes are divided by ``scale``, and so is the horizon
+line, before the stabilised rows — and the detector's noise floor ``sigma_z`` becomes
+``sigma_z / scale`` there (:meth:`~seawatch.tracking.mtt.MultiTargetTracker.
+set_pixel_size`); then the pan's accumulated shift is subtracted. A fixed camera
+accumulates neither and is tracked as without it.
 
 The water-line pixel of a track is its box centre plus a smoothed offset from the box
 centre to the detector's water-line point (the bottom-centre of the box until a
@@ -219,8 +223,9 @@ class VisualTracker:
         stabilise: track the boxes in horizon-stabilised rows (module docstring); while
             no horizon has been found the rows are the frame's.
         motion: camera-motion compensation (module docstring): a panning or yawing
-            camera's frame-to-frame shift is measured in :meth:`stream` and :meth:`step`
-            (not for precomputed detections given to :meth:`update` alone).
+            camera's frame-to-frame shift and a zooming camera's scale are measured in
+            :meth:`stream` and :meth:`step` (not for precomputed detections given to
+            :meth:`update` alone).
         fps: frame rate used when frames come without times [1/s].
         filter_options: further keyword arguments of the AFKF/FKF (``rule``, ``gain``,
             ``window``, ``g_max``, ``delta``).
@@ -335,11 +340,17 @@ class VisualTracker:
 
     def _restart_motion(self) -> None:
         self._shifts: deque[FloatArray] = deque()  # offsets measured, not yet tracked
+        self._zooms: deque[FloatArray] = deque()  # zooms measured, not yet tracked
         self._lines: deque[Any] = deque()  # horizons queued, not yet tracked
         self._forget_lines()
         self.camera_offset = np.zeros(2)
         """The accumulated camera shift (x, y) [px] of the last frame tracked
         (:class:`~seawatch.vision.motion.CameraMotion`; 0 for a fixed camera)."""
+        self.camera_zoom = np.array([1.0, 0.0, 0.0])
+        """The accumulated zoom of the last frame tracked and the frame centre it is
+        taken out about, ``(scale, cx, cy)`` [–, px, px] (1 for a camera that does not
+        zoom)."""
+        self._pixel = 1.0  # the detector's pixel in the tracker's coordinates (1 / scale)
         if self._motion is not None:
             self._motion.reset()
 
@@ -367,6 +378,14 @@ class VisualTracker:
             self.camera_offset = self._shifts.popleft()
         return self.camera_offset
 
+    def next_zoom(self) -> FloatArray:
+        """The camera zoom ``(scale, cx, cy)`` measured for the next frame to track, taken
+        from the queue :meth:`stream` fills, as :meth:`next_offset`; the last one when
+        none is waiting."""
+        if self._zooms:
+            self.camera_zoom = self._zooms.popleft()
+        return self.camera_zoom
+
     def _forget_lines(self) -> None:
         """Start the stabilised rows afresh (no line taken)."""
         self._line: FloatArray | None = None  # the last line taken (x0, y0, x1, y1)
@@ -387,6 +406,7 @@ class VisualTracker:
         :meth:`update`."""
         if self._motion is not None:
             self._shifts.append(self._motion.update(image, horizon))
+            self._zooms.append(np.r_[self._motion.scale, self._motion.centre])
         if self.stabilise:
             self._lines.append(horizon)
 
@@ -405,7 +425,7 @@ class VisualTracker:
             if line is None:
                 return None
             g1, g0 = self._given
-            ok = g1 is not None and _line_jump(line, g1, g0) <= LINE_GATE
+            ok = g1 is not None and _line_jump(line, g1, g0) <= LINE_GATE * self._pixel
             self._steady = self._steady + 1 if ok else 0
             self._given = (line, g1)
             if self._steady < LINE_SETTLE:
@@ -415,7 +435,8 @@ class VisualTracker:
         last, before = self._line, self._line_before
         ahead = self._held + 1  # frames since the last line taken
         if line is not None and (
-            self._held >= LINE_HOLD or _line_jump(line, last, before, ahead) <= LINE_GATE
+            self._held >= LINE_HOLD
+            or _line_jump(line, last, before, ahead) <= LINE_GATE * self._pixel
         ):
             # the line a frame before this one, on the way from the last one taken
             back = None if self._held >= LINE_HOLD else line - (line - last) / ahead
@@ -462,6 +483,7 @@ class VisualTracker:
         *,
         offset: ArrayLike | None = None,
         horizon: Any = _QUEUED,
+        zoom: ArrayLike | None = None,
     ) -> FloatArray:
         """Track one frame's detections (steps 2–3); returns the confirmed tracks.
 
@@ -470,6 +492,9 @@ class VisualTracker:
                 with a score or (k, 7) with the water-line point; None: no detection.
             offset: the frame's accumulated camera shift (x, y) [px]; default: the one
                 :meth:`stream` or :meth:`step` measured for this frame, else the last.
+            zoom: the frame's accumulated zoom ``(scale, cx, cy)`` (:meth:`next_zoom`);
+                default: the one :meth:`stream` or :meth:`step` measured for this frame,
+                else the last.
             horizon: the frame's horizon for the stabilised rows (a
                 :class:`~seawatch.vision.horizon.HorizonEstimate`, a line
                 ``(x0, y0, x1, y1)`` [px] or None); default: the one :meth:`stream` or
@@ -486,11 +511,25 @@ class VisualTracker:
             off = self.next_offset()
         else:
             off = self.camera_offset = as_float_array("offset", offset).reshape(2)
+        if zoom is None:
+            scale, centre = self.next_zoom()[0], self.camera_zoom[1:]
+        else:
+            self.camera_zoom = as_float_array("zoom", zoom).reshape(3)
+            scale, centre = self.camera_zoom[0], self.camera_zoom[1:]
         hz = self.next_horizon() if horizon is _QUEUED else horizon
         if self._frame == 0 and self._sigma_a is None and self.stabilise and hz is not None:
             # horizons come with the frames: the vertical noise of stabilised rows
             args = {**self._mtt_args, "sigma_a": STABILISED_SIGMA_A}
             self.mtt = MultiTargetTracker(self._factory, **args)
+        if 1.0 / scale != self._pixel:
+            self._pixel = 1.0 / positive("zoom scale", scale)
+            self.mtt.set_pixel_size(self._pixel)
+        if scale != 1.0:  # to the first frame's focal length (module docstring)
+            _unzoom(rows, scale, centre)
+            points = _horizon_points(hz)
+            if points is not None:  # and into the first frame's rows
+                ends = centre[[0, 1, 0, 1]] + (np.array(points) - centre[[0, 1, 0, 1]]) / scale
+                hz = ends - [0.0, off[1], 0.0, off[1]]
         line = self._lift(hz) if self.stabilise else None
         # into stabilised rows (at each box's centre column and water-line point)
         rows[:, 1] -= self._rise(line, rows[:, 0] + 0.5 * rows[:, 2])
@@ -505,6 +544,8 @@ class VisualTracker:
         out[:, 5:7] += off
         out[:, 2] += self._rise(line, out[:, 1] + 0.5 * out[:, 3])
         out[:, 6] += self._rise(line, out[:, 5])
+        if scale != 1.0:
+            _unzoom(out[:, 1:], 1.0 / scale, centre)
         return out
 
     def coast(self, frames: int) -> None:
@@ -652,6 +693,7 @@ class VisualTracker:
         detections: Sequence[Any],
         offsets: Sequence[ArrayLike] | None = None,
         horizons: Sequence[Any] | None = None,
+        zooms: Sequence[ArrayLike] | None = None,
     ) -> list[FloatArray]:
         """Per-frame confirmed tracks of precomputed per-frame detections (no detector).
 
@@ -659,16 +701,18 @@ class VisualTracker:
         ``offsets``: the frames' camera offsets (:meth:`next_offset` while they were
         detected); None: a fixed camera. ``horizons``: the frames' horizons for the
         stabilised rows (:meth:`next_horizon` while they were detected); None: none.
+        ``zooms``: the frames' camera zooms (:meth:`next_zoom`); None: no zoom.
         """
         n = len(detections)
-        for name, seq in (("offsets", offsets), ("horizons", horizons)):
+        for name, seq in (("offsets", offsets), ("horizons", horizons), ("zooms", zooms)):
             if seq is not None and len(seq) != n:
                 raise ValueError(f"{name}: expected one per frame ({n}), got {len(seq)}")
         offs = [(0.0, 0.0)] * n if offsets is None else offsets
         lines = [None] * n if horizons is None else horizons
+        scales = [(1.0, 0.0, 0.0)] * n if zooms is None else zooms
         return [
-            self.update(d, offset=o, horizon=h)
-            for d, o, h in zip(detections, offs, lines, strict=True)
+            self.update(d, offset=o, horizon=h, zoom=z)
+            for d, o, h, z in zip(detections, offs, lines, scales, strict=True)
         ]
 
     # ------------------------------------------------------------------ output
@@ -705,6 +749,15 @@ class VisualTracker:
             out[r, 5:7] = centres[i] + off
             out[r, 7] = st.misses[i]
         return out
+
+
+def _unzoom(rows: FloatArray, scale: float, centre: FloatArray) -> None:
+    """Boxes ``x, y, w, h, score, u_wl, v_wl`` (k, 7) of a frame zoomed by ``scale``
+    about ``centre`` (x, y) [px], in place, as at the first frame's focal length: each
+    point ``c + (p − c) / scale``, each size ``/ scale``."""
+    for col in (0, 5):
+        rows[:, col : col + 2] = centre + (rows[:, col : col + 2] - centre) / scale
+    rows[:, 2:4] /= scale
 
 
 def frames_lost(index: int, last_index: int, step: int = 1) -> int:
