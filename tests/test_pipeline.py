@@ -110,3 +110,22 @@ def test_a_found_horizon_refines_the_attitude_whatever_its_confidence(confidence
     assert got is not None
     assert got.pitch == pytest.approx(want.pitch, abs=1e-6)
     assert got.roll == pytest.approx(want.roll, abs=1e-6)
+
+
+def test_a_zoomed_frame_is_seen_through_the_zoomed_camera():
+    """The visual tracker measured a zoom out to 0.6 about the frame's centre: the
+    camera file's focal length is the first frame's, so a pixel of this frame has the
+    angles of its unmagnified pixel, and the detected horizon (zoomed with the frame)
+    still gives the file's attitude."""
+    cam = PinholeCamera.from_fov(960, 540, 60.0, height=15.0, pitch=math.radians(-3.0))
+    centre = np.array([479.5, 269.5])
+    scale = 0.6
+    first = np.array([700.0, 320.0])  # a ship's water line in the first frame's pixels
+    now = centre + scale * (first - centre)
+    y0, y1 = horizon_line(cam).endpoints(960)[:, 1]
+    y0, y1 = centre[1] + scale * (np.array([y0, y1]) - centre[1])  # a level line
+    est = HorizonEstimate.from_endpoints(float(y0), float(y1), 960, 540, confidence=0.9)
+    got, _ = _Pose(cam, None, None, "horizon", []).at(0.0, est, np.r_[scale, centre])
+    assert got is not None
+    np.testing.assert_allclose(got.pixel_to_angles(now), cam.pixel_to_angles(first), atol=1e-9)
+    assert got.pitch == pytest.approx(cam.pitch, abs=1e-6)

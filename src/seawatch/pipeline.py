@@ -7,7 +7,9 @@ This module only wires the stages (STYLE.md); each stage is its own module:
    visual tracks with their water-line pixel (seed 001, ALGORITHMS.md §1);
 3. camera pose per frame — the camera file's intrinsics (scaled to the frames when
    they are the same view at another resolution, also when a stream's resolution
-   changes; frames of another aspect ratio stop the job as bad input), height and
+   changes; frames of another aspect ratio stop the job as bad input; the focal length
+   scaled by the zoom the visual tracker measured, the file's being the first
+   frame's: :meth:`seawatch.camera.PinholeCamera.zoomed`), height and
    attitude; on a moving platform the NAV pose (:mod:`seawatch.io.nav`) gives position
    and heading; the detected horizon refines pitch and roll
    (:func:`seawatch.camera.attitude_from_horizon`, §4.3) when it is found with
@@ -237,10 +239,18 @@ class _Pose:
         if platform is not None:
             self.lat0, self.lon0 = platform.lat0, platform.lon0
 
-    def at(self, time: float, horizon: Any) -> tuple[PinholeCamera | None, PlatformPose | None]:
+    def at(
+        self, time: float, horizon: Any, zoom: Any = None
+    ) -> tuple[PinholeCamera | None, PlatformPose | None]:
         """(camera with its world attitude, platform pose) at video time ``time`` [s];
-        (None, None) where the NAV does not cover the time (positions unknown)."""
+        (None, None) where the NAV does not cover the time (positions unknown).
+        ``zoom``: the frame's camera zoom ``(scale, cx, cy)`` measured by the visual
+        tracker (:attr:`~seawatch.vision.tracker.VisualTracker.camera_zoom`): the
+        camera file's focal length is the first frame's, and a zoom scales it
+        (:meth:`~seawatch.camera.PinholeCamera.zoomed`)."""
         cam = self.camera
+        if zoom is not None and float(zoom[0]) != 1.0:
+            cam = cam.zoomed(float(zoom[0]), (float(zoom[1]), float(zoom[2])))
         pose = None
         if self.platform is not None:
             with warnings.catch_warnings(record=True) as caught:
@@ -656,7 +666,7 @@ def track_video(
                 if gone:
                     world.drop(np.fromiter(gone, np.int64))
                 live_ids = set(tids.tolist())
-                cam, ppose = pose.at(t, horizon)
+                cam, ppose = pose.at(t, horizon, vtracker.camera_zoom)
                 if cam is not None and k:
                     az, dep, cov = _angles(cam, rows[:, 5:7], sigma_px)
                     # a coasting visual track (no detection this frame) reports its pixel

@@ -189,6 +189,42 @@ def test_resized_camera_sees_each_direction_at_the_scaled_pixel(name, scale, daz
     assert abs(_ang_diff(back[0], az)) < 1e-9 and abs(back[1] - el) < 1e-9
 
 
+@given(
+    name=st.sampled_from(sorted(CAMERAS)),
+    scale=st.floats(0.3, 3.0),
+    daz=st.floats(-10.0, 10.0),
+    del_=st.floats(-5.0, 5.0),
+    cu=st.floats(0.2, 0.8),
+    cv=st.floats(0.2, 0.8),
+)
+def test_zoomed_camera_sees_each_direction_at_the_magnified_pixel(name, scale, daz, del_, cu, cv):
+    """A zoom magnifies the image by ``scale`` about a centre c: the direction seen at
+    pixel p is seen at c + scale (p − c), lens distortion included, and a pixel's angles
+    are those of its unmagnified pixel (the world stage of a zooming camera)."""
+    cam = CAMERAS[name].with_attitude(0.3, math.radians(-2.0), math.radians(1.5))
+    w, h = cam.image_size
+    centre = np.array([cu * w, cv * h])
+    zoomed = cam.zoomed(scale, tuple(centre))
+    assert (zoomed.image_size, zoomed.dist, zoomed.heading) == (
+        cam.image_size,
+        cam.dist,
+        cam.heading,
+    )
+    az, el = 0.3 + math.radians(daz), math.radians(-2.0 + del_)
+    uv = cam.angles_to_pixel(az, el)
+    assume(np.all(np.isfinite(uv)) and -0.5 <= uv[0] <= w - 0.5 and -0.5 <= uv[1] <= h - 0.5)
+    expected = centre + scale * (uv - centre)
+    np.testing.assert_allclose(zoomed.angles_to_pixel(az, el), expected, rtol=0, atol=1e-6)
+    back = zoomed.pixel_to_angles(expected)
+    assert abs(_ang_diff(back[0], az)) < 1e-9 and abs(back[1] - el) < 1e-9
+    assert cam.zoomed(scale).cx == pytest.approx(cam.cx)  # about the principal point
+
+
+def test_zoomed_rejects_a_bad_scale():
+    with pytest.raises(ValueError, match="scale"):
+        IDEAL.zoomed(0.0)
+
+
 def test_resized_rejects_a_bad_size():
     with pytest.raises(ValueError, match="image_size"):
         IDEAL.resized((960, 0))

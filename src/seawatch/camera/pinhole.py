@@ -237,6 +237,26 @@ class PinholeCamera:
             image_size=(int(size[0]), int(size[1])),
         )
 
+    def zoomed(self, scale: float, centre: tuple[float, float] | None = None) -> PinholeCamera:
+        """The camera whose image is this one's magnified by ``scale`` about ``centre``
+        (x, y) [px] (default: the principal point): a zoom lens's focal length times
+        ``scale``, ``fx' = s fx``, ``fy' = s fy``, ``cx' = c_x + s (cx − c_x)`` and
+        likewise in y, so that the ray seen at pixel ``p`` is seen at
+        ``c + s (p − c)``; the distortion, on normalised coordinates, is unchanged (a
+        zoom lens whose distortion changes with its focal length needs a calibration
+        per focal length), as are the attitude, height and position.
+        (:class:`~seawatch.vision.motion.CameraMotion` measures ``scale`` about the
+        frame's centre.)"""
+        s = positive("scale", scale)
+        cx, cy = (self.cx, self.cy) if centre is None else vector("centre", centre, 2)
+        return dataclasses.replace(
+            self,
+            fx=self.fx * s,
+            fy=self.fy * s,
+            cx=float(cx + s * (self.cx - cx)),
+            cy=float(cy + s * (self.cy - cy)),
+        )
+
     def with_attitude(
         self, heading: float | None = None, pitch: float | None = None, roll: float | None = None
     ) -> PinholeCamera:

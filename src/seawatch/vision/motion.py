@@ -53,27 +53,37 @@ the offset stays 0 and the tracker is exactly the uncompensated one.
 Zoom (a PTZ camera changing its focal length, an EO sight zooming in on a contact): the
 frame is magnified by ``s`` about its centre ``c`` from one frame to the next, so a
 point moves by ``(s − 1)(p − c)``, away from the centre or towards it. The real MarDCT
-ir-3 clip (``../shared/data/mardct_ir3/``) zooms out by 5–8 % a frame for its first 13
-frames: the boat, nearly still on the sea, crosses 150 px of the frame, and stops dead
-when the zoom does. The scale is measured as the difference of the horizontal shifts of
-the sky band's left and right halves, ``s − 1 = (d_right − d_left) / (W/2)`` (their
-centres lie half the band's width apart), refined by warping the earlier band with the
-scale found and measuring the halves again until the change is under 0.1 % (at most
-three rounds); the shift is then the whole band's against the warped one. On that clip
-it gives the scales a search over ``s`` in steps of 0.25 % finds (phase-correlation peak
-at its best) to 0.3–1.7 %, and 0.02–0.3 % on its still frames; on the rendered fixed
-cameras 0.03–0.04 % (median; at most 0.23 %). A Fourier–Mellin registration (log-polar
-magnitude spectra, the textbook method) was tried first: on the clip's zooming frames it
-gave scales within 0.4 % of 1 but one of 10.5, with peaks of 0.08–0.57. Both halves'
-peaks must reach ``min_response``. A zoom starts when two frames in a row change the
-scale the same way by ``gate_zoom`` or more (the scale's noise is far below it, and a
-zoom seldom lasts the window's frames: the clip's 13 frames would lose five) and goes on
-while the mean ``|ln s|`` of the window is at least half of it; unlike a pan's, a zoom's
+ir-3 clip (``../shared/data/mardct_ir3/``) zooms out by 5–8 % a frame in its frames
+1–13: the boat, nearly still on the sea, crosses 150 px of the frame and stops dead when
+the zoom does. The scale is measured from the horizontal shifts of the sky band's left
+and right halves, ``s − 1 = (d_right − d_left) / (W/2)`` (their centres lie half the
+band's width apart), refined by magnifying the earlier band by the scale found and
+measuring the halves again, until a round changes it by under 0.1 % (at most three
+rounds; a first round under 0.1 % gives exactly 1); the pan's shift is then the whole
+band's against the magnified one. A half's first peak is weak under a zoom (the half is
+stretched); both of the last round's must reach ``min_response``. Then the rows must
+agree (:meth:`CameraMotion._vertical_agrees`): the band's upper and lower halves shift
+alike once magnified, which a zoom does and a widening of the columns alone does not —
+the rendered uav-sea clip, a boat's camera turning, widens its sky by 0.4–0.8 % a frame
+across for 60 frames with the rows 0.2 % closer together. On MarDCT the scales add up to
+0.456 at frame 17, where one registration of frames 0 and 17 (a search over the scale)
+finds 0.455; the rendered fixed cameras (24 clips) measure no change but in 0–2 of 200
+frames, at most 0.15 %, the moving ones at most 0.26 % (uav-sea) and 0.41 % (the pan
+clip). A Fourier–Mellin registration (log-polar magnitude spectra, the textbook method)
+was tried first: on MarDCT's zooming frames it gave scales within 0.4 % of 1 but one of
+10.5, with peaks of 0.08–0.57.
+
+A zoom starts when two frames in a row change the scale the same way by ``gate_zoom`` or
+more, the first of them included (a zoom seldom lasts a window's frames: the clip's 13
+would lose five), and goes on while the mean ``|ln s|`` of the window is at least half
+of it; a frame not measured meanwhile takes the last step. Unlike a pan's, a zoom's
 steps are not smoothed by the window's median, as a zoom lens stops dead. The zoom is
 accumulated in ``scale`` and taken out about the frame's centre ``c``: the frame's pixel
 ``p`` is ``c + (p − c) / scale`` at the first frame's focal length, and the pan's
 ``offset`` is added up there (a shift ``d`` measured at ``scale`` is ``d / scale`` of
-it). Without a zoom ``scale`` is 1 and everything is as above.
+it). While zooming, the vertical shift is added up too: MarDCT's zoom centre lies about
+12 px above the frame's (0.5–1 px a frame, 6 px by frame 17). Without a zoom ``scale``
+is 1 and everything is as above.
 """
 
 from __future__ import annotations
@@ -321,8 +331,10 @@ def _magnify(image: FloatArray, s: float, centre: FloatArray) -> FloatArray:
 
 def _correlate(a: FloatArray, b: FloatArray, hann: FloatArray) -> tuple[tuple[float, float], float]:
     """``cv2.phaseCorrelate(a, b, hann)`` on copies: OpenCV (5.0.0 here) multiplies its
-    inputs by the window in place (measured: a float32 array, whole or a view of its
-    rows, equals ``a · hann`` to the last bit afterwards). Until session 29 the band
-    kept for the next frame was so windowed, and windowed again there: on the
-    rendered pan clip from frame 39 on, where the sky band kept its height."""
+    inputs by the window in place where their size needs no padding for the DFT
+    (measured: a float32 band of 108 × 480 px, whole or a view of its rows, equals
+    ``a · hann`` to the last bit afterwards; one of 106, 107 or 122–124 rows is left
+    alone). Until session 29 the band kept for the next frame was so windowed, and
+    windowed again there: on the rendered pan clip from frame 39 on (its sky band 108
+    rows high), not on uav-sea's 1080p frames."""
     return cv2.phaseCorrelate(a.copy(), b.copy(), hann)  # type: ignore[no-any-return]

@@ -525,7 +525,7 @@ class VisualTracker:
             self._pixel = 1.0 / positive("zoom scale", scale)
             self.mtt.set_pixel_size(self._pixel)
         if scale != 1.0:  # to the first frame's focal length (module docstring)
-            _unzoom(rows, scale, centre)
+            _magnify(rows, 1.0 / scale, centre, box=0)
             points = _horizon_points(hz)
             if points is not None:  # and into the first frame's rows
                 ends = centre[[0, 1, 0, 1]] + (np.array(points) - centre[[0, 1, 0, 1]]) / scale
@@ -545,7 +545,7 @@ class VisualTracker:
         out[:, 2] += self._rise(line, out[:, 1] + 0.5 * out[:, 3])
         out[:, 6] += self._rise(line, out[:, 5])
         if scale != 1.0:
-            _unzoom(out[:, 1:], 1.0 / scale, centre)
+            _magnify(out, scale, centre, box=1)
         return out
 
     def coast(self, frames: int) -> None:
@@ -751,13 +751,15 @@ class VisualTracker:
         return out
 
 
-def _unzoom(rows: FloatArray, scale: float, centre: FloatArray) -> None:
-    """Boxes ``x, y, w, h, score, u_wl, v_wl`` (k, 7) of a frame zoomed by ``scale``
-    about ``centre`` (x, y) [px], in place, as at the first frame's focal length: each
-    point ``c + (p − c) / scale``, each size ``/ scale``."""
-    for col in (0, 5):
-        rows[:, col : col + 2] = centre + (rows[:, col : col + 2] - centre) / scale
-    rows[:, 2:4] /= scale
+def _magnify(rows: FloatArray, scale: float, centre: FloatArray, box: int) -> None:
+    """Rows of boxes magnified by ``scale`` about ``centre`` (x, y) [px], in place: the
+    box ``x, y, w, h`` in columns ``box`` … ``box + 3`` and the water-line point in
+    columns 5–6 (a detection row ``x, y, w, h, score, u_wl, v_wl`` with ``box`` 0, a
+    track row of :data:`TRACK_COLUMNS` with 1); each point ``c + scale (p − c)``, each
+    size ``scale`` times."""
+    for col in (box, 5):
+        rows[:, col : col + 2] = centre + scale * (rows[:, col : col + 2] - centre)
+    rows[:, box + 2 : box + 4] *= scale
 
 
 def frames_lost(index: int, last_index: int, step: int = 1) -> int:
