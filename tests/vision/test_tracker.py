@@ -406,6 +406,11 @@ def test_a_zooming_camera_is_tracked_at_the_first_frames_focal_length(name):
             bottom = tracks[:, 1:3] + tracks[:, 3:5] * [0.5, 1.0]
             np.testing.assert_allclose(tracks[:, 5:7], bottom, atol=0.5)
             assert np.all(tracks[:, 7] == 0)
+            # zoomed out, a detector's pixel is 1 / 0.96¹⁵ of the first frame's: so is
+            # its noise floor there; a new video starts at the first frame's again
+            assert vt.mtt.sigma_z == pytest.approx(2.0 / 0.96**15)
+            vt.reset()
+            assert vt.mtt.sigma_z == 2.0
     assert errors[True] < errors[False] / 2, errors
 
 

@@ -351,6 +351,7 @@ class VisualTracker:
         taken out about, ``(scale, cx, cy)`` [–, px, px] (1 for a camera that does not
         zoom)."""
         self._pixel = 1.0  # the detector's pixel in the tracker's coordinates (1 / scale)
+        self.mtt.set_pixel_size(1.0)
         if self._motion is not None:
             self._motion.reset()
 
@@ -521,13 +522,15 @@ class VisualTracker:
             # horizons come with the frames: the vertical noise of stabilised rows
             args = {**self._mtt_args, "sigma_a": STABILISED_SIGMA_A}
             self.mtt = MultiTargetTracker(self._factory, **args)
+        scale = positive("zoom scale", scale)
         if 1.0 / scale != self._pixel:
-            self._pixel = 1.0 / positive("zoom scale", scale)
+            self._pixel = 1.0 / scale
             self.mtt.set_pixel_size(self._pixel)
         if scale != 1.0:  # to the first frame's focal length (module docstring)
             _magnify(rows, 1.0 / scale, centre, box=0)
+        if scale != 1.0 or off[1] != 0.0:  # the line too, into the first frame's rows
             points = _horizon_points(hz)
-            if points is not None:  # and into the first frame's rows
+            if points is not None:
                 ends = centre[[0, 1, 0, 1]] + (np.array(points) - centre[[0, 1, 0, 1]]) / scale
                 hz = ends - [0.0, off[1], 0.0, off[1]]
         line = self._lift(hz) if self.stabilise else None
