@@ -527,7 +527,7 @@ class VisualTracker:
             self._pixel = 1.0 / scale
             self.mtt.set_pixel_size(self._pixel)
         if scale != 1.0:  # to the first frame's focal length (module docstring)
-            _magnify(rows, 1.0 / scale, centre, box=0)
+            _magnify_rows(rows, 1.0 / scale, centre, box=0)
         if scale != 1.0 or off[1] != 0.0:  # the line too, into the first frame's rows
             points = _horizon_points(hz)
             if points is not None:
@@ -548,7 +548,7 @@ class VisualTracker:
         out[:, 2] += self._rise(line, out[:, 1] + 0.5 * out[:, 3])
         out[:, 6] += self._rise(line, out[:, 5])
         if scale != 1.0:
-            _magnify(out, scale, centre, box=1)
+            _magnify_rows(out, scale, centre, box=1)
         return out
 
     def coast(self, frames: int) -> None:
@@ -754,7 +754,7 @@ class VisualTracker:
         return out
 
 
-def _magnify(rows: FloatArray, scale: float, centre: FloatArray, box: int) -> None:
+def _magnify_rows(rows: FloatArray, scale: float, centre: FloatArray, box: int) -> None:
     """Rows of boxes magnified by ``scale`` about ``centre`` (x, y) [px], in place: the
     box ``x, y, w, h`` in columns ``box`` … ``box + 3`` and the water-line point in
     columns 5–6 (a detection row ``x, y, w, h, score, u_wl, v_wl`` with ``box`` 0, a
