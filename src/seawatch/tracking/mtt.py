@@ -387,8 +387,7 @@ class MultiTargetTracker:
     ) -> None:
         self.dt = positive("dt", dt)
         self.sigma_a = axis_sigmas(_DIM, sigma_a, "sigma_a")
-        self.sigma_z = positive("sigma_z", sigma_z)
-        self._sigma_z_given = self.sigma_z  # [detector px] (set_pixel_size)
+        self._sigma_z_given = positive("sigma_z", sigma_z)  # [detector px] (set_pixel_size)
         self.sigma_v0 = positive("sigma_v0", sigma_v0)
         self.sigma_z_rel = positive("sigma_z_rel", sigma_z_rel, allow_zero=True)
         if gate_threshold is None:
@@ -414,8 +413,7 @@ class MultiTargetTracker:
         self.occlusion = bool(occlusion)
         self.filter_options = dict(filter_options or {})
         self.H = position_measurement(_DIM, 2)
-        self.R = self.sigma_z**2 * np.eye(_DIM)
-        self.P0 = np.diag([self.sigma_z**2] * _DIM + [self.sigma_v0**2] * _DIM)
+        self.set_pixel_size(1.0)  # sigma_z, R, P0
         self.F, self.Q = constant_velocity(_DIM, self.dt, self.sigma_a)
         self._factory = self._make_factory(filter_factory)
         self.batched = self._factory is None
