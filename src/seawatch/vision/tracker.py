@@ -513,10 +513,10 @@ class VisualTracker:
         else:
             off = self.camera_offset = as_float_array("offset", offset).reshape(2)
         if zoom is None:
-            scale, centre = self.next_zoom()[0], self.camera_zoom[1:]
+            self.next_zoom()
         else:
             self.camera_zoom = as_float_array("zoom", zoom).reshape(3)
-            scale, centre = self.camera_zoom[0], self.camera_zoom[1:]
+        scale, centre = self.camera_zoom[0], self.camera_zoom[1:]
         hz = self.next_horizon() if horizon is _QUEUED else horizon
         if self._frame == 0 and self._sigma_a is None and self.stabilise and hz is not None:
             # horizons come with the frames: the vertical noise of stabilised rows
