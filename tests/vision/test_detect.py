@@ -1410,19 +1410,32 @@ def test_union_rects_covers_every_rectangle_with_disjoint_ones(spec):
         assert [min(r[2] for r in inside), max(r[3] for r in inside)] == a[2:]
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="known gap (session 29): a ship longer than about 12 % of the frame's width is "
-    "boxed only in part or not at all — the rendered large ship magnified about itself "
-    "and cropped to 960 x 540: whole at 11.4 % of the width (110 px), its superstructure "
-    "alone (22-34 px) at 12.2 % and 13.1 %, nothing at 14.3 % and 17.5 %; not yet "
-    "analysed (the CFAR's windows at its coarsest scale are the first suspect)",
+@pytest.mark.parametrize(
+    "scale",
+    [
+        1.64,
+        2.2,
+        2.7,
+        pytest.param(
+            3.0,
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="known gap: a ship longer than about 24 % of the frame's width "
+                "(here 251 px at 960) is no longer boxed whole — at the coarsest scale "
+                "the CFAR's guard cells reach 108 px (12 × 9) from a pixel, and the "
+                "hull's middle is its own background",
+            ),
+        ),
+    ],
 )
-@pytest.mark.parametrize("scale", [1.64])
-def test_a_near_ship_filling_a_seventh_of_the_width_is_boxed_whole(tmp_path, scale):
+def test_a_near_ship_filling_a_large_part_of_the_width_is_boxed_whole(tmp_path, scale):
     """A ship near the camera (or zoomed in on) fills much of the frame: the rendered
-    large ship, 84 px long at 960 px, seen at ``scale`` times that (138 px, 14 % of the
-    width): one box over at least 80 % of its length."""
+    large ship, 84 px long at 960 px, seen at ``scale`` times that (138, 184 and 226 px:
+    14, 19 and 24 % of the width): one box over at least 90 % of its length, its ends
+    within 3 % of the true ones. Up to session 29 nothing was boxed from 14 %: at the
+    coarsest scale the ship's own contrast in the training windows of the sea beside it
+    set the noise level (σ 42 for its contrast of 113); now that sea is left out of the
+    noise cells (``_window_hits``)."""
     from seawatch.io.video import VideoReader
     from seawatch.scenarios.ship_video import read_truth
     from seawatch.synth import render_case
@@ -1436,4 +1449,80 @@ def test_a_near_ship_filling_a_seventh_of_the_width_is_boxed_whole(tmp_path, sca
     left, top = int(scale * (x + w / 2)) - 480, max(0, int(scale * (y + h / 2)) - 270)
     view = np.ascontiguousarray(big[top : top + 540, left : left + 960])
     boxes = ClassicalShipDetector()(view, horizon=detect_horizon(view)).boxes
-    assert boxes.shape[0] >= 1 and boxes[:, 2].max() >= 0.8 * scale * w
+    assert boxes.shape[0] >= 1
+    ship = boxes[np.argmax(boxes[:, 2])]
+    x0, x1 = scale * x - left, scale * (x + w) - left  # the true ends in the view
+    assert ship[2] >= 0.9 * scale * w
+    assert abs(ship[0] - x0) < 0.03 * scale * w and abs(ship[0] + ship[2] - x1) < 0.03 * scale * w
+
+
+def test_a_ship_is_not_boxed_across_the_gap_to_the_next():
+    """Two ships side by side in one object mask, 10 px of sea between them, their water
+    lines 4 px apart, the right one's first two columns ending on the left one's level (a
+    bow rising): each ship gets its own columns (``_frame_ships``). Until session 30 the
+    left one took the right one's bow across the gap (the rendered meeting case, seed 1,
+    frame 0: the ferry's box 52.8 px for its 39.5)."""
+    from seawatch.vision.waterline import _frame_ships
+
+    rng = np.random.default_rng(0)
+    img = np.full((120, 200), 160.0) + rng.normal(0.0, 1.0, (120, 200))
+    img[:40] = 200.0
+    img[50:60, 40:80] = 60.0  # the far ship: columns 40-79, water line at row 59.5
+    img[50:64, 90:116] = 100.0  # the near one: columns 90-115, water line at 63.5
+    img[60:64, 90:92] = 160.0  # ... its bow's two columns end at the far one's level
+    img = np.clip(img, 0, 255).astype(np.uint8)
+    fr = ClassicalShipDetector().prepare(img).frame
+    x0, y0 = 36, 44
+    ships = _frame_ships(fr, img[y0:70, x0:120] < 130, x0, y0)
+    spans = sorted((x0 + c0, x0 + c1, v) for c0, c1, _, _, _, v, _ in ships)
+    assert [s[:2] for s in spans] == [(40, 79), (90, 115)]
+    assert [s[2] for s in spans] == pytest.approx([59.5, 63.5], abs=0.1)
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(
+    st.integers(0, 2**31 - 1),
+    st.integers(1, 6),
+    st.integers(1, 8),
+    st.floats(0.0, 0.05),
+)
+def test_window_hits_are_the_pixels_whose_training_windows_hold_a_strong_pixel(
+    seed, guard, flank, density
+):
+    """``_window_hits`` against a direct reading of the CFAR's windows
+    (``_contrast_kernel``: 3 rows × ``flank`` columns, ending ``guard`` columns left of
+    the pixel / starting ``guard`` columns right of it): a pixel is hit when it, or a
+    window's part inside the image, holds a strong pixel."""
+    from seawatch.vision.detect import _window_hits
+
+    rng = np.random.default_rng(seed)
+    strong = rng.random((9, 40)) < density
+    hit = _window_hits(strong, guard, flank)
+    h, w = strong.shape
+    for r in range(h):
+        rows = strong[max(0, r - 1) : r + 2]
+        for j in range(w):
+            left = rows[:, max(0, j - guard - flank) : max(0, j - guard)]
+            right = rows[:, min(w, j + guard + 1) : min(w, j + guard + flank + 1)]
+            assert hit[r, j] == bool(left.any() or right.any() or rows[:, j].any())
+
+
+def test_censored_cell_noise_leaves_out_a_long_ship_s_shadow():
+    """``_cell_grid`` with ``censor``: Gaussian noise (σ = 1) whose middle columns hold a
+    ship's contrast (+40): uncensored, the 30 % quantile of its two middle cells (of four
+    in a row) is the contrast's (and of the outer two, half covered, inflated too);
+    censored, the other values give σ within 20 % (the estimate's standard error is 5-7
+    %) — of the cell where a quarter of it is left, else of its row of cells."""
+    from seawatch.vision.detect import _cell_grid
+
+    rng = np.random.default_rng(7)
+    d = rng.normal(0.0, 1.0, (32, 256)).astype(np.float32)
+    shadow = np.zeros(d.shape, bool)
+    shadow[:, 32:224] = True  # the middle cells (64 columns) and half of the outer two
+    d[shadow] += 40.0
+    plain, ch, cw = _cell_grid(d, 8, 64, 1, 0.3)
+    censored, _, _ = _cell_grid(d, 8, 64, 1, 0.3, censor=shadow)
+    assert (ch, cw) == (8, 64)
+    assert plain[:, 1:3].min() > 30.0 and plain[:, [0, 3]].min() > 1.5
+    assert np.allclose(censored, 1.0, rtol=0.2)
+    assert np.array_equal(_cell_grid(d, 8, 64, 1, 0.3, censor=np.zeros_like(shadow))[0], plain)
