@@ -1290,7 +1290,8 @@ class ClassicalShipDetector:
             else:
                 g = cv2.resize(band[: hk * f, : wk * f], (wk, hk), interpolation=cv2.INTER_AREA)
                 if k >= 2:  # the finest scale's targets, by level pixel
-                    hot = (out[0].z[: hk * f, : wk * f] > self.threshold).astype(np.float32)
+                    z0 = out[0].z[: hk * f, : wk * f]
+                    hot = cv2.threshold(z0, self.threshold, 1.0, cv2.THRESH_BINARY)[1]
                     share = cv2.resize(hot, (wk, hk), interpolation=cv2.INTER_AREA)
                     strong = share >= _STRONG_SHARE
             out.append(self._level(g, f, floor / f, guard, flank, fr, strong))
