@@ -774,6 +774,10 @@ def _polarity_bits(d: NDArray, out: NDArray | None = None) -> NDArray:
 _POLARITY_CODE = {"both": 0, "bright": 1, "dark": 2}  # the contrast kernels' ``polarity``
 
 _CENSOR_GAP = 3
+"""Least gap [working px] above or below a candidate to a target found with censored
+windows (:meth:`ClassicalShipDetector._censored`): nearer, it is the candidate's own
+rim (the smoothing spreads a hull by a pixel, the box grows by one more). Beside it the
+gap is the CFAR's ``guard``."""
 _STRONG_SHARE = 0.25
 """From the third scale on, a level pixel is a target's whose block holds at least this
 share of finest-scale pixels above the detection threshold: the sea beside it, whose
@@ -781,10 +785,6 @@ training windows hold it, is left out of the noise cells (``_window_hits``). Mea
 on the rendered large ship magnified (session 30): with a block's any one pixel (0), the
 sea texture's own small detections censored nearly every cell at twice the magnification
 and the ship was lost; 0.5 lost it at 23.6 % of the frame's width, 0.25 keeps it."""
-"""Least gap [working px] above or below a candidate to a target found with censored
-windows (:meth:`ClassicalShipDetector._censored`): nearer, it is the candidate's own
-rim (the smoothing spreads a hull by a pixel, the box grows by one more). Beside it the
-gap is the CFAR's ``guard``."""
 
 
 @dataclass
@@ -927,9 +927,10 @@ class ClassicalShipDetector:
        structure is no target; ships may be brighter or darker than the sea).
     3. Noise ``σ = max(σ_cell, σ_ring)``: ``σ_cell`` = robust spread of
        ``|g − (L + R)/2|`` in cells of ``cell`` pixels (median, at coarse scales the 30 %
-       quantile over a quarter of the width, from the third scale on of
-       ``min(|g − L|, |g − R|)``: a long ship in one training window of the sea beside
-       it is no noise; then the median of three horizontal cells);
+       quantile over a quarter of the width, from the third scale on leaving out the
+       sea whose training windows hold a finest-scale target, ``_window_hits``: there
+       ``|g − (L + R)/2|`` is a long ship's contrast, no noise; then the median of three
+       horizontal cells);
        ``σ_ring`` = the RMS local detail ``g − box5(g)`` in the quieter of the two
        training windows (high over glitter, whitecaps, textured land). Statistic
        ``z = c / σ``; for a colour frame the chroma planes' ``z`` (at half the working
