@@ -7,8 +7,10 @@ camera roll); hulls painted with their exact area coverage at fractional water l
 (and sloping, one in front of another, with a sub-pixel mast), blurred like a lens;
 rendered H.264 footage (``seawatch.synth.render``) against its ``truth.csv``; 88 real
 thermal frames with a hand-made boat box per frame (MarDCT video ir-3 annotated by the
-TIRSD repository, Apache-2.0; ``../shared/data/mardct_ir3/``, read in place); hand-built
-YOLO output tensors whose boxes are known. Both object refinements of the classical
+TIRSD repository, Apache-2.0; ``../shared/data/mardct_ir3/``, read in place); a real
+boat-camera image with a moored sailboat whose hull's columns are read off its pixels
+(WaSR's example 03, ``../shared/data/horizon/``, a known gap); hand-built YOLO output
+tensors whose boxes are known. Both object refinements of the classical
 detector (``refine="mask"``, the default, and ``"flank"``) are checked.
 """
 
