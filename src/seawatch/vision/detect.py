@@ -681,6 +681,23 @@ def _window_hits(strong: NDArray[np.bool_], guard: int, flank: int) -> NDArray[n
     return (left > 0) | (right > 0) | (s > 0)
 
 
+def _wide_blocks(
+    d: NDArray, c: NDArray, tex: NDArray, cell_h: int, floor: float, threshold: float
+) -> NDArray[np.bool_]:
+    """9 × 9 blocks of the finest scale that hold a target wider than the noise cells:
+    at least ``_STRONG_SHARE`` of their pixels with contrast ``c`` above ``threshold``
+    times the noise of their row of cells across the whole width (the 30 % quantile of
+    ``|d|``, which a target filling up to two thirds of the width leaves unmoved) or the
+    local detail ``tex``, where larger [units of ``d``]."""
+    row = _cell_noise(d, cell_h, d.shape[1], floor, step=2, quantile=0.3)
+    hot = (c > threshold * np.maximum(row, tex)).astype(np.float32)
+    hb, wb = d.shape[0] // 9, d.shape[1] // 9
+    if hb == 0 or wb == 0:
+        return np.zeros((0, 0), bool)
+    share = cv2.resize(hot[: hb * 9, : wb * 9], (wb, hb), interpolation=cv2.INTER_AREA)
+    return share >= _STRONG_SHARE
+
+
 def _upsample(q: NDArray, shape: tuple[int, int], ch: int, cw: int, floor: float) -> NDArray:
     """A cell grid bilinearly interpolated to ``shape`` (cells of ``ch × cw``), floored."""
     q = np.maximum(q, np.float32(floor))
@@ -785,6 +802,20 @@ training windows hold it, is left out of the noise cells (``_window_hits``). Mea
 on the rendered large ship magnified (session 30): with a block's any one pixel (0), the
 sea texture's own small detections censored nearly every cell at twice the magnification
 and the ship was lost; 0.5 lost it at 23.6 % of the frame's width, 0.25 keeps it."""
+_WIDE_ASPECT = 4.0
+"""A target of the wide-target pass (:meth:`ClassicalShipDetector._wide`) is at most this
+many times wider than high (its component at its scale). Near enough to be wider than
+the noise cells, a ship shows its hull's and superstructure's height; the sun's glare
+band under the horizon beside a ship, 66 × 6.6 and 80 × 7.6 px in the rendered lighting
+case, is not one (session 32: with no limit lighting's mean CLE rose 2.896 → 2.954 %;
+with 3 to 6 the six WaSR images keep the same boxes)."""
+_WIDE_FACTOR = 1.5
+"""The wide-target pass asks its component's peak z to exceed this many times the
+detection threshold: its noise is the 30 % quantile of a row of cells across the width
+at a coarse scale, few independent samples. On the 24 rendered clips its components
+that were no ship (cloud shadows, the frame's left and right edges, where a CFAR has
+one training window) peaked at z 6.0–8.5, the WaSR buoy and white hull at 12.9–22.2
+(session 32; a tuned value, from those two sets)."""
 
 
 @dataclass
@@ -802,6 +833,8 @@ class _Level:
     # (1 bright, 2 dark, 3 either)
     window: tuple[int, int] = (0, 0)  # the CFAR's (guard, flank) at this scale [px]
     planes: tuple[NDArray, NDArray] | None = None  # smoothed plane g and its 5 × 5 mean
+    blocks: NDArray[np.bool_] | None = None  # finest scale: its 9 × 9 blocks that hold a
+    # target wider than the noise cells (:func:`_wide_blocks`), None when not looked for
 
 
 @dataclass
@@ -953,6 +986,17 @@ class ClassicalShipDetector:
        their boxes left out of the training windows and noise cells, and components
        clear of every candidate join as candidates of their own (merged only with one
        another), refined on those censored maps.
+    4b. With ``wide=True`` (the default; not with ``temporal``) targets wider than the
+       noise cells, whose own contrast fills the cells and holds their ``z`` down at
+       every scale (a moored yacht 80 px long in a 512-px frame, a buoy of 100 px), are
+       looked for in a pass of their own (:meth:`_wide`): 9 × 9 blocks of the finest
+       scale where a quarter of the pixels exceed the threshold against the noise of
+       their whole row of cells across the width (:func:`_wide_blocks`) mark the
+       sea to leave out of the coarser scales' noise cells, computed again; components
+       below the horizon, wider than the next finer scale's CFAR sees, at most
+       ``_WIDE_ASPECT`` times wider than high and peaking above ``_WIDE_FACTOR`` × the
+       threshold, through the clutter test, replace the candidates of their polarity
+       inside them. The candidates of steps 4–5 are left as they were.
     5. Inside each candidate, at full resolution, an object mask — ``refine="mask"``
        (default, :meth:`_refine_mask`): the pixels whose noise-normalised contrast
        against the level's CFAR backgrounds exceeds 0.4 × its 95th percentile p in the
@@ -1037,6 +1081,7 @@ class ClassicalShipDetector:
         max_candidates: int = 200,
         refine: Literal["mask", "flank"] = "mask",
         censor: bool = True,
+        wide: bool = True,
     ) -> None:
         self.threshold = positive("threshold", threshold)
         self.grow_threshold = positive("grow_threshold", grow_threshold)
@@ -1056,14 +1101,14 @@ class ClassicalShipDetector:
         self.min_area = positive("min_area", min_area, allow_zero=True)
         self.max_size = in_range("max_size", max_size, 0.0, 1.0, lo_open=True)
         try:
-            wide, tall = (float(v) for v in max_aspect)
+            flat, tall = (float(v) for v in max_aspect)
         except (TypeError, ValueError):
             raise ValueError(
                 f"max_aspect: expected (w/h, h/w) limits, got {max_aspect!r}"
             ) from None
-        if not (wide >= 1 and tall >= 1 and math.isfinite(wide) and math.isfinite(tall)):
+        if not (flat >= 1 and tall >= 1 and math.isfinite(flat) and math.isfinite(tall)):
             raise ValueError(f"max_aspect: expected finite limits >= 1, got {max_aspect!r}")
-        self.max_aspect = (wide, tall)
+        self.max_aspect = (flat, tall)
         self.border = integer("border", border, 0)
         self.merge_gap = positive("merge_gap", merge_gap, allow_zero=True)
         self.max_above = in_range("max_above", max_above, 0.0, 1.0)
@@ -1078,6 +1123,7 @@ class ClassicalShipDetector:
             raise ValueError(f"refine: expected 'mask' or 'flank', got {refine!r}")
         self.refine: Literal["mask", "flank"] = refine
         self.censor = bool(censor)
+        self.wide = bool(wide)
         self._buffers: dict[tuple[Any, ...], NDArray] = {}
 
     def reset(self) -> None:
@@ -1152,6 +1198,21 @@ class ClassicalShipDetector:
         if self.censor and not self.temporal and cands:
             hidden = self._censored(every, cands, levels[0], floor)
         cands = self._merge(self._resolve_scales(cands))
+        if self.wide and not self.temporal and levels[0].blocks is not None:
+            wide = [
+                c
+                for c in self._wide(levels, band, floor, fr, cands)
+                if self._near_sea(c, fr, mask, ends, tol)
+            ]
+            if wide:  # they replace the candidates of their polarity inside them
+                kept = [
+                    c
+                    for c in cands
+                    if not any(
+                        c.polarity & w.polarity and _frac_inside(c.box, w.box) >= 0.5 for w in wide
+                    )
+                ]
+                cands = kept + wide
         # a target found beside a candidate is another object: merged only with its kind
         cands += self._merge([c for c in hidden if self._near_sea(c, fr, mask, ends, tol)])
         # merged, a ship's candidate reaches down to its hull: one whose bottom is above
@@ -1321,11 +1382,15 @@ class ClassicalShipDetector:
         flank: int,
         pol: int,
         strong: NDArray | None = None,
-    ) -> tuple[tuple[NDArray, NDArray], NDArray, NDArray, NDArray, NDArray, NDArray]:
+        wide: bool = False,
+    ) -> tuple[
+        tuple[NDArray, NDArray], NDArray, NDArray, NDArray, NDArray, NDArray, NDArray | None
+    ]:
         """Smoothed plane and its 5 × 5 mean, CFAR backgrounds, signed contrast ``d``,
         contrast ``c`` and noise ``σ`` of one plane at one scale (class docstring, steps
-        2–3)."""
+        2–3); with ``wide`` (finest scale) also its :func:`_wide_blocks`, else None."""
         shape = g.shape
+        blocks = None
         gs = cv2.GaussianBlur(
             g, (3, 3), 0.8, dst=self._buffer(f"g{tag}", shape), borderType=cv2.BORDER_REPLICATE
         )
@@ -1334,12 +1399,14 @@ class ClassicalShipDetector:
         _contrast_kernel(gs, b5, guard, flank, pol, hi, lo, d, c, tex)
         if factor == 1:
             base = _cell_noise(d, self.cell[0], self.cell[1], floor, step=2)
+            if wide:
+                blocks = _wide_blocks(d, c, tex, self.cell[0], floor, self.threshold)
         else:  # coarser scales: cells of a quarter of the width, every pixel
             ch, cw = max(4, self.cell[0] // 2), max(16, shape[1] // 4)
             hit = None if strong is None else _window_hits(strong, guard, flank)
             base = _cell_noise(d, ch, cw, floor, step=1, quantile=0.3, censor=hit)
         sigma = np.maximum(base, tex, out=tex)
-        return (gs, b5), hi, lo, d, c, sigma
+        return (gs, b5), hi, lo, d, c, sigma, blocks
 
     def _level(
         self,
@@ -1350,14 +1417,16 @@ class ClassicalShipDetector:
         flank: int,
         fr: _Frame,
         strong: NDArray[np.bool_] | None = None,
+        suffix: str = "",
     ) -> _Level:
         """Contrast, noise and statistic maps of one scale (class docstring, steps 2–3);
         at the finest scale of a colour frame the chroma planes' statistics join in
         (``z = max(z_Y, z_Cr, z_Cb)``), so that a boat of the sea's brightness but not its
         colour is found."""
         pol = _POLARITY_CODE[self.polarity]
-        planes, hi, lo, d, c, sigma = self._contrast(
-            g, f"y{factor}", factor, floor, guard, flank, pol, strong
+        wide = factor == 1 and self.wide and not self.temporal
+        planes, hi, lo, d, c, sigma, blocks = self._contrast(
+            g, f"y{factor}{suffix}", factor, floor, guard, flank, pol, strong, wide
         )
         gs = planes[0]
         if self.temporal:
@@ -1365,7 +1434,7 @@ class ClassicalShipDetector:
         z = np.divide(c, sigma, out=c)
         sign = _NO_SIGN
         if pol == 0:  # bright where g > (L + R)/2 (then g − max(L, R) > min(L, R) − g)
-            sign = _polarity_bits(d, self._work(f"sign{factor}", d.shape, np.uint8))
+            sign = _polarity_bits(d, self._work(f"sign{factor}{suffix}", d.shape, np.uint8))
         chroma = None
         if factor == 1 and fr.chroma:
             chroma = []
@@ -1373,7 +1442,7 @@ class ClassicalShipDetector:
             for ch_index, plane in fr.chroma:
                 if plane.shape[1] < 2 * (gc + fc) + 1 or plane.shape[0] < 4:
                     continue
-                _, hc, lc, _, cc, sc = self._contrast(
+                _, hc, lc, _, cc, sc, _ = self._contrast(
                     plane, f"c{ch_index}", 1, 2.0 * floor, gc, fc, 0
                 )
                 zc = cv2.resize(np.divide(cc, sc, out=cc), (z.shape[1], z.shape[0]))
@@ -1381,7 +1450,7 @@ class ClassicalShipDetector:
                     np.putmask(sign, zc > z, 3)
                 np.maximum(z, zc, out=z)
                 chroma.append((ch_index, hc, lc, sc))
-        return _Level(factor, hi, lo, sigma, z, chroma, sign, (guard, flank), planes)
+        return _Level(factor, hi, lo, sigma, z, chroma, sign, (guard, flank), planes, blocks)
 
     def _apply_temporal(
         self,
@@ -1591,6 +1660,79 @@ class ClassicalShipDetector:
             for cand in found:
                 cand.maps = maps
             out += found
+        return out
+
+    def _wide(
+        self,
+        levels: list[_Level],
+        band: NDArray,
+        floor: float,
+        fr: _Frame,
+        cands: list[_Candidate],
+    ) -> list[_Candidate]:
+        """Targets wider than the noise cells (class docstring, step 4b): the coarser
+        scales again, with the sea whose training windows hold a wide block of the finest
+        scale (:func:`_wide_blocks`) left out of their noise cells and the rows above
+        the horizon out of the search. A component wider than the next finer scale's
+        CFAR sees whole, of a ship's shape, at most ``_WIDE_ASPECT`` times wider than
+        high, whose peak exceeds ``_WIDE_FACTOR`` times the threshold and that passes the
+        clutter test at its own scale (ring without the candidates and the components
+        that touch it: a dark stern or shadow beside a white hull is its own part) and
+        that no candidate of its polarity spans, is a candidate with these maps."""
+        blocks = levels[0].blocks
+        if blocks is None or not blocks.any():
+            return []
+        out: list[_Candidate] = []
+        for k in range(1, len(levels)):
+            f = levels[k].factor
+            hk, wk = levels[k].z.shape
+            g = cv2.resize(band[: hk * f, : wk * f], (wk, hk), interpolation=cv2.INTER_AREA)
+            share = cv2.resize(blocks.astype(np.float32), (wk, hk), interpolation=cv2.INTER_AREA)
+            guard, flank = levels[k].window
+            lw = self._level(g, f, floor / f, guard, flank, fr, share > 0, suffix="w")
+            lw.z[: max(0, min(hk, math.floor(fr.hrow / f)))] = 0  # sky and land: no sea
+            boxes, peaks, _, pols = _grow_kernel(
+                lw.z,
+                lw.sign,
+                np.float32(self.threshold),
+                -(-self.border // f),
+                np.float32(self.grow_threshold),
+                np.zeros(hk * wk, np.uint8),
+                np.empty(hk * wk, np.int64),
+            )
+            if boxes.shape[0] == 0:
+                continue
+            w = (boxes[:, 2] - boxes[:, 0] + 1) * f
+            h = (boxes[:, 3] - boxes[:, 1] + 1) * f
+            ok = (
+                self._ship_shaped(w, h, band.shape, f)
+                & (w > (2 * self.guard + 1) * 3 ** (k - 1))
+                & (w <= _WIDE_ASPECT * h)
+                & (peaks > _WIDE_FACTOR * self.threshold)
+            )
+            grow = (lw.z > self.grow_threshold).view(np.uint8).copy()
+            for o in cands:  # targets that passed are no clutter
+                x0, y0, x1, y1 = (int(v) // f for v in o.box)
+                grow[max(0, y0) : y1 + 1, max(0, x0) : x1 + 1] = 0
+            for i in np.flatnonzero(ok):
+                x0, y0, x1, y1 = boxes[i]
+                ring = grow.copy()
+                for a0, b0, a1, b1 in boxes:  # itself and the components that touch it
+                    if a0 <= x1 + 1 and a1 >= x0 - 1 and b0 <= y1 + 1 and b1 >= y0 - 1:
+                        ring[b0 : b1 + 1, a0 : a1 + 1] = 0
+                cand = _Candidate(boxes[i].astype(float), k, float(peaks[i]), int(pols[i]))
+                if not self._clutter_pass(cand, cv2.integral(ring), lw.z.shape):
+                    continue
+                cand.box = np.array([x0 * f, y0 * f, (x1 + 1) * f - 1, (y1 + 1) * f - 1], float)
+                cand.maps = lw
+                spanned = any(
+                    o.polarity & cand.polarity
+                    and _overlap(o.box, cand.box)
+                    and o.box[2] - o.box[0] >= 0.8 * (cand.box[2] - cand.box[0])
+                    for o in cands + out
+                )
+                if not spanned:
+                    out.append(cand)
         return out
 
     def _ship_shaped(
