@@ -742,6 +742,14 @@ def _in_sea(
     return True
 
 
+def _clear_boxes(mask: NDArray, cands: list[_Candidate], f: int = 1) -> None:
+    """Set ``mask`` (a map at scale ``f``) to 0 over the candidates' inclusive boxes
+    (working pixels), in place."""
+    for c in cands:
+        x0, y0, x1, y1 = (int(v) // f for v in c.box)
+        mask[max(0, y0) : y1 + 1, max(0, x0) : x1 + 1] = 0
+
+
 def _area(box: NDArray) -> float:
     """Area of an inclusive box (x0, y0, x1, y1) [pixels]."""
     return float((box[2] - box[0] + 1) * (box[3] - box[1] + 1))
@@ -833,6 +841,7 @@ class _Level:
     # (1 bright, 2 dark, 3 either)
     window: tuple[int, int] = (0, 0)  # the CFAR's (guard, flank) at this scale [px]
     planes: tuple[NDArray, NDArray] | None = None  # smoothed plane g and its 5 × 5 mean
+    source: NDArray | None = None  # the scale's working band, before the smoothing
     blocks: NDArray[np.bool_] | None = None  # finest scale: its 9 × 9 blocks that hold a
     # target wider than the noise cells (:func:`_wide_blocks`), None when not looked for
 
@@ -1198,7 +1207,7 @@ class ClassicalShipDetector:
         if self.censor and not self.temporal and cands:
             hidden = self._censored(every, cands, levels[0], floor)
         cands = self._merge(self._resolve_scales(cands))
-        if self.wide and not self.temporal and levels[0].blocks is not None:
+        if levels[0].blocks is not None:  # wide=True, not temporal (:meth:`_level`)
             wide = [
                 c
                 for c in self._wide(levels, band, floor, fr, cands)
@@ -1450,7 +1459,8 @@ class ClassicalShipDetector:
                     np.putmask(sign, zc > z, 3)
                 np.maximum(z, zc, out=z)
                 chroma.append((ch_index, hc, lc, sc))
-        return _Level(factor, hi, lo, sigma, z, chroma, sign, (guard, flank), planes, blocks)
+        window = (guard, flank)
+        return _Level(factor, hi, lo, sigma, z, chroma, sign, window, planes, g, blocks)
 
     def _apply_temporal(
         self,
@@ -1680,16 +1690,15 @@ class ClassicalShipDetector:
         that touch it: a dark stern or shadow beside a white hull is its own part) and
         that no candidate of its polarity spans, is a candidate with these maps."""
         blocks = levels[0].blocks
-        if blocks is None or not blocks.any():
+        if blocks is None or not blocks.any():  # none on a frame without a wide target
             return []
         out: list[_Candidate] = []
-        for k in range(1, len(levels)):
-            f = levels[k].factor
-            hk, wk = levels[k].z.shape
-            g = cv2.resize(band[: hk * f, : wk * f], (wk, hk), interpolation=cv2.INTER_AREA)
+        for k, lv in enumerate(levels[1:], start=1):
+            f = lv.factor
+            hk, wk = lv.z.shape
             share = cv2.resize(blocks.astype(np.float32), (wk, hk), interpolation=cv2.INTER_AREA)
-            guard, flank = levels[k].window
-            lw = self._level(g, f, floor / f, guard, flank, fr, share > 0, suffix="w")
+            guard, flank = lv.window
+            lw = self._level(lv.source, f, floor / f, guard, flank, fr, share > 0, suffix="w")
             lw.z[: max(0, min(hk, math.floor(fr.hrow / f)))] = 0  # sky and land: no sea
             boxes, peaks, _, pols = _grow_kernel(
                 lw.z,
@@ -1711,9 +1720,7 @@ class ClassicalShipDetector:
                 & (peaks > _WIDE_FACTOR * self.threshold)
             )
             grow = (lw.z > self.grow_threshold).view(np.uint8).copy()
-            for o in cands:  # targets that passed are no clutter
-                x0, y0, x1, y1 = (int(v) // f for v in o.box)
-                grow[max(0, y0) : y1 + 1, max(0, x0) : x1 + 1] = 0
+            _clear_boxes(grow, cands, f)  # targets that passed are no clutter
             for i in np.flatnonzero(ok):
                 x0, y0, x1, y1 = boxes[i]
                 ring = grow.copy()
@@ -1788,9 +1795,7 @@ class ClassicalShipDetector:
             if not failed or not clear:
                 continue
             masked = grow.copy()
-            for c in clear:
-                x0, y0, x1, y1 = (int(v) for v in c.box)
-                masked[max(0, y0) : y1 + 1, max(0, x0) : x1 + 1] = 0
+            _clear_boxes(masked, clear)
             ii_clear = cv2.integral(masked)
             for i in failed:
                 passed[i] = self._clutter_pass(cands[i], ii_clear, grow.shape)
