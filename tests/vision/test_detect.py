@@ -35,6 +35,7 @@ from seawatch.vision.detect import (
     sea_region,
     waterline_points,
 )
+from seawatch.vision.detect import _one_sided_hits as one_sided_hits
 from seawatch.vision.detect import _trim_other_polarity as trim_other_polarity
 from seawatch.vision.detect import _union_rects as union_rects
 from seawatch.vision.external import (
@@ -1493,6 +1494,68 @@ def test_a_wide_target_on_a_real_image_is_boxed_whole(name, x0, x1):
     4: z ≤ 4.2 at every scale)."""
     assert _wasr_cover(name, x0, x1) >= 0.8
     assert _wasr_cover(name, x0, x1, wide=False) < 0.5
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.integers(6, 40),
+    st.integers(1, 8),
+    st.integers(2, 10),
+    st.integers(0, 2**31 - 1),
+)
+def test_one_sided_hits_are_the_edge_pixels_whose_one_window_holds_a_strong_pixel(
+    w, guard, flank, seed
+):
+    """:func:`_one_sided_hits` against its definition pixel by pixel: within guard +
+    flank columns of the left edge the right window (3 rows × flank columns starting
+    guard + 1 to the right), within as many of the right edge the left one, holds a
+    strong pixel (rows past the top and bottom are no rows)."""
+    strong = np.random.default_rng(seed).random((7, w)) < 0.08
+    got = one_sided_hits(strong, guard, flank)
+    edge = min(guard + flank, w)
+    want = np.zeros_like(strong)
+    for r in range(7):
+        rows = strong[max(0, r - 1) : r + 2]
+        for j in range(w):
+            if j < edge and rows[:, j + guard + 1 : j + guard + 1 + flank].any():
+                want[r, j] = True
+            if j >= w - edge and rows[:, max(0, j - guard - flank) : max(0, j - guard)].any():
+                want[r, j] = True
+    np.testing.assert_array_equal(got, want)
+
+
+def test_a_close_boat_on_the_rendered_uav_clip_is_boxed_whole_without_an_echo(tmp_path):
+    """The rendered ``uav-sea`` clip (1920 × 1080, our renderer's default) in its last
+    seconds, the work boat 105-92 m off and 172-221 px long, its superstructure rising
+    above the horizon, the sea right of it within guard + flank of the frame's right edge
+    at the second scale. The wide-target pass boxes the whole boat (seeded on its hull
+    below the horizon, grown past it; with the search cut at the horizon it boxed the
+    hull alone, 40 px low) and no box beside it: the sea there, whose one training window
+    holds the dark hull, is its echo (a bright 187 × 71 px box in frames 680 and 685 in
+    session 32)."""
+    import av
+
+    from seawatch.synth.platform_clip import render_platform_clip
+    from seawatch.vision.horizon import detect_horizon
+
+    clip = render_platform_clip(tmp_path, duration=68.6)
+    truth = {int(r["frame"]): r for r in csv.DictReader(clip.truth.open())}
+    det = ClassicalShipDetector()
+    seen = []
+    with av.open(str(clip.video)) as container:
+        for i, frame in enumerate(container.decode(video=0)):
+            if i not in (670, 678, 680, 685):
+                continue
+            image = frame.to_ndarray(format="bgr24")
+            boxes = det(image, horizon=detect_horizon(image)).boxes
+            x, y, w, h = (float(truth[i][k]) for k in "xywh")
+            ours = [b for b in boxes if b[0] < x + w and b[0] + b[2] > x]  # columns shared
+            assert len(ours) == 1, f"frame {i}: {boxes[:, :4].round(1).tolist()}"
+            edges = np.r_[ours[0][:2], ours[0][:2] + ours[0][2:4]]
+            np.testing.assert_allclose(edges, [x, y, x + w, y + h], atol=3.0)
+            assert not any(b[0] >= x + w - 10 and b[1] < y + h for b in boxes), f"frame {i}"
+            seen.append(i)
+    assert seen == [670, 678, 680, 685]
 
 
 def test_a_ship_is_not_boxed_across_the_gap_to_the_next():

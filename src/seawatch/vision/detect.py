@@ -681,6 +681,28 @@ def _window_hits(strong: NDArray[np.bool_], guard: int, flank: int) -> NDArray[n
     return (left > 0) | (right > 0) | (s > 0)
 
 
+def _one_sided_hits(strong: NDArray[np.bool_], guard: int, flank: int) -> NDArray[np.bool_]:
+    """The pixels within ``guard + flank`` columns of the left or right edge, where the
+    contrast kernels have one training window (:func:`_contrast_kernel`), whose window
+    holds a ``strong`` pixel: there a target in it makes its own sea beside it look like a
+    target of the other polarity."""
+    s = cv2.dilate(strong.view(np.uint8), np.ones((3, 1), np.uint8))
+    h, w = s.shape
+    out = np.zeros((h, w), bool)
+    edge = min(guard + flank, w)
+    if edge == 0:
+        return out
+    cs = np.zeros((h, w + 1), np.int32)
+    np.cumsum(s, axis=1, out=cs[:, 1:])
+    j = np.arange(edge)  # left edge: the right window, columns j + guard + 1 …
+    a, b = np.clip(j + guard + 1, 0, w), np.clip(j + guard + 1 + flank, 0, w)
+    out[:, :edge] = cs[:, b] > cs[:, a]
+    j = np.arange(w - edge, w)  # right edge: the left window, … columns j − guard − 1
+    a, b = np.clip(j - guard - flank, 0, w), np.clip(j - guard, 0, w)
+    out[:, w - edge :] |= cs[:, b] > cs[:, a]
+    return out
+
+
 def _wide_blocks(
     d: NDArray, c: NDArray, tex: NDArray, cell_h: int, floor: float, threshold: float
 ) -> NDArray[np.bool_]:
@@ -742,12 +764,12 @@ def _in_sea(
     return True
 
 
-def _clear_boxes(mask: NDArray, cands: list[_Candidate], f: int = 1) -> None:
-    """Set ``mask`` (a map at scale ``f``) to 0 over the candidates' inclusive boxes
-    (working pixels), in place."""
+def _clear_boxes(mask: NDArray, cands: list[_Candidate], f: int = 1, value: int = 0) -> None:
+    """Set ``mask`` (a map at scale ``f``) to ``value`` over the candidates' inclusive
+    boxes (working pixels), in place."""
     for c in cands:
         x0, y0, x1, y1 = (int(v) // f for v in c.box)
-        mask[max(0, y0) : y1 + 1, max(0, x0) : x1 + 1] = 0
+        mask[max(0, y0) : y1 + 1, max(0, x0) : x1 + 1] = value
 
 
 def _area(box: NDArray) -> float:
@@ -1002,7 +1024,9 @@ class ClassicalShipDetector:
        scale where a quarter of the pixels exceed the threshold against the noise of
        their whole row of cells across the width (:func:`_wide_blocks`) mark the
        sea to leave out of the coarser scales' noise cells, computed again; components
-       below the horizon, wider than the next finer scale's CFAR sees, at most
+       seeded below the horizon where the CFAR has both training windows (they grow
+       past either: a ship's superstructure above the horizon joins its hull), wider
+       than the next finer scale's CFAR sees, at most
        ``_WIDE_ASPECT`` times wider than high and peaking above ``_WIDE_FACTOR`` × the
        threshold, through the clutter test, replace the candidates of their polarity
        inside them. The candidates of steps 4–5 are left as they were.
@@ -1682,8 +1706,11 @@ class ClassicalShipDetector:
     ) -> list[_Candidate]:
         """Targets wider than the noise cells (class docstring, step 4b): the coarser
         scales again, with the sea whose training windows hold a wide block of the finest
-        scale (:func:`_wide_blocks`) left out of their noise cells and the rows above
-        the horizon out of the search. A component wider than the next finer scale's
+        scale (:func:`_wide_blocks`) left out of their noise cells, and seeds only below
+        the horizon and where both training windows lie in the image (within guard +
+        flank of the left or right edge the one window holds the wide target, which
+        then echoes in its own sea as a target of the other polarity). A component,
+        grown past either, wider than the next finer scale's
         CFAR sees whole, of a ship's shape, at most ``_WIDE_ASPECT`` times wider than
         high, whose peak exceeds ``_WIDE_FACTOR`` times the threshold and that passes the
         clutter test at its own scale (ring without the candidates and the components
@@ -1699,7 +1726,12 @@ class ClassicalShipDetector:
             share = cv2.resize(blocks.astype(np.float32), (wk, hk), interpolation=cv2.INTER_AREA)
             guard, flank = lv.window
             lw = self._level(lv.source, f, floor / f, guard, flank, fr, share > 0, suffix="w")
-            lw.z[: max(0, min(hk, math.floor(fr.hrow / f)))] = 0  # sky and land: no sea
+            # seeds lie on the sea and where the CFAR has both training windows: beyond
+            # guard + flank of the left or right edge it has one, and a wide target in it
+            # echoes as a target of the other polarity; components grow into both
+            cap = np.float32(self.threshold) * np.float32(0.999)
+            sky = lw.z[: max(0, min(hk, math.floor(fr.hrow / f)))]
+            np.minimum(sky, cap, out=sky)
             boxes, peaks, _, pols = _grow_kernel(
                 lw.z,
                 lw.sign,
@@ -1740,7 +1772,25 @@ class ClassicalShipDetector:
                 )
                 if not spanned:
                     out.append(cand)
-        return out
+        return [c for c in out if not self._echo(c, cands + out)]
+
+    def _echo(self, c: _Candidate, targets: list[_Candidate]) -> bool:
+        """Whether every seed of wide candidate ``c`` (``z`` above the threshold in its
+        box, of its polarity) lies within guard + flank of the left or right edge with its one training
+        window on a target of the other polarity (:func:`_one_sided_hits`): the sea beside
+        that target, echoing it."""
+        lv = c.maps
+        f, (guard, flank) = lv.factor, lv.window
+        held = np.zeros(lv.z.shape, np.uint8)
+        _clear_boxes(held, [t for t in targets if not t.polarity & c.polarity], f, 1)
+        if not held.any():
+            return False
+        x0, y0, x1, y1 = (int(v) // f for v in c.box)
+        win = np.s_[y0 : y1 + 1, x0 : x1 + 1]
+        seeds = lv.z[win] > self.threshold
+        if lv.sign.shape == lv.z.shape:  # polarity "both": seeds of its own polarity
+            seeds &= (lv.sign[win] & c.polarity) > 0
+        return not (seeds & ~_one_sided_hits(held > 0, guard, flank)[win]).any()
 
     def _ship_shaped(
         self, w: NDArray, h: NDArray, shape: tuple[int, int], f: int
