@@ -1008,7 +1008,11 @@ class MultiTargetTracker:
         of a track with :data:`_SETTLED_HITS` detections is blocked too where the box's
         bottom is on the track's predicted one (within the tolerance) and its top lies
         above the track's by more than twice the tolerance (something behind the
-        ship: a ship beyond it, a coast; its height is known by then). With both
+        ship: a ship beyond it, a coast; its height is known by then). A box bottom
+        below the bottom of a ship behind the track (that ship's bottom above the
+        track's predicted one) and nearer the track's predicted bottom than that ship's
+        is not blocked by it: a union box's bottom is its lowest, the track's water
+        line. With both
         edges free the box is the track's own: its centre and size are measured. With
         one free edge the centre is that edge moved inwards by half the track's
         remembered size, unless the blocked edge stops at the near side of every ship
@@ -1047,6 +1051,11 @@ class MultiTargetTracker:
             shares &= (oarea * _RESTART_GROWTH > area)[..., None]  # not a speck on a ship
             on_lo = shares & (olo - t <= lo[:, None]) & (lo[:, None] <= ohi + t)
             on_hi = shares & (olo - t <= hi[:, None]) & (hi[:, None] <= ohi + t)
+            # a box bottom below the water line of a ship behind the track (its bottom
+            # above the track's), nearer the track's predicted bottom than that ship's:
+            # the track's own water line (a union box's bottom is its lowest)
+            hy, oy, ty = hi[:, None, 1], ohi[..., 1], thi[..., 1]
+            on_hi[..., 1] &= ~((oy < ty) & (hy > oy) & (hy - oy > np.abs(hy - ty)))
             if self._own is not None:
                 # a box around the whole of a ship not behind the track (its water line
                 # not above the track's) that has another box of its own this scan is no

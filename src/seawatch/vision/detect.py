@@ -1024,11 +1024,11 @@ class ClassicalShipDetector:
        scale where a quarter of the pixels exceed the threshold against the noise of
        their whole row of cells across the width (:func:`_wide_blocks`) mark the
        sea to leave out of the coarser scales' noise cells, computed again; components
-       seeded below the horizon where the CFAR has both training windows (they grow
-       past either: a ship's superstructure above the horizon joins its hull), wider
-       than the next finer scale's CFAR sees, at most
-       ``_WIDE_ASPECT`` times wider than high and peaking above ``_WIDE_FACTOR`` × the
-       threshold, through the clutter test, replace the candidates of their polarity
+       seeded below the horizon (grown past it: a close ship's superstructure joins its
+       hull), wider than the next finer scale's CFAR sees, at most ``_WIDE_ASPECT``
+       times wider than high and peaking above ``_WIDE_FACTOR`` × the threshold,
+       through the clutter test and not the echo of a target in the one training window
+       near the frame's edge (:meth:`_echo`), replace the candidates of their polarity
        inside them. The candidates of steps 4–5 are left as they were.
     5. Inside each candidate, at full resolution, an object mask — ``refine="mask"``
        (default, :meth:`_refine_mask`): the pixels whose noise-normalised contrast
@@ -1706,16 +1706,14 @@ class ClassicalShipDetector:
     ) -> list[_Candidate]:
         """Targets wider than the noise cells (class docstring, step 4b): the coarser
         scales again, with the sea whose training windows hold a wide block of the finest
-        scale (:func:`_wide_blocks`) left out of their noise cells, and seeds only below
-        the horizon and where both training windows lie in the image (within guard +
-        flank of the left or right edge the one window holds the wide target, which
-        then echoes in its own sea as a target of the other polarity). A component,
-        grown past either, wider than the next finer scale's
+        scale (:func:`_wide_blocks`) left out of their noise cells and seeds only below
+        the horizon. A component, grown past it, wider than the next finer scale's
         CFAR sees whole, of a ship's shape, at most ``_WIDE_ASPECT`` times wider than
         high, whose peak exceeds ``_WIDE_FACTOR`` times the threshold and that passes the
         clutter test at its own scale (ring without the candidates and the components
         that touch it: a dark stern or shadow beside a white hull is its own part) and
-        that no candidate of its polarity spans, is a candidate with these maps."""
+        that no candidate of its polarity spans, is a candidate with these maps, unless
+        it is another target's echo (:meth:`_echo`)."""
         blocks = levels[0].blocks
         if blocks is None or not blocks.any():  # none on a frame without a wide target
             return []
@@ -1726,9 +1724,7 @@ class ClassicalShipDetector:
             share = cv2.resize(blocks.astype(np.float32), (wk, hk), interpolation=cv2.INTER_AREA)
             guard, flank = lv.window
             lw = self._level(lv.source, f, floor / f, guard, flank, fr, share > 0, suffix="w")
-            # seeds lie on the sea and where the CFAR has both training windows: beyond
-            # guard + flank of the left or right edge it has one, and a wide target in it
-            # echoes as a target of the other polarity; components grow into both
+            # seeds lie on the sea; components grow past the horizon (a superstructure)
             cap = np.float32(self.threshold) * np.float32(0.999)
             sky = lw.z[: max(0, min(hk, math.floor(fr.hrow / f)))]
             np.minimum(sky, cap, out=sky)
@@ -1776,9 +1772,9 @@ class ClassicalShipDetector:
 
     def _echo(self, c: _Candidate, targets: list[_Candidate]) -> bool:
         """Whether every seed of wide candidate ``c`` (``z`` above the threshold in its
-        box, of its polarity) lies within guard + flank of the left or right edge with its one training
-        window on a target of the other polarity (:func:`_one_sided_hits`): the sea beside
-        that target, echoing it."""
+        box, of its polarity) lies within guard + flank of the left or right edge with
+        its one training window on a target of the other polarity
+        (:func:`_one_sided_hits`): the sea beside that target, echoing it."""
         lv = c.maps
         f, (guard, flank) = lv.factor, lv.window
         held = np.zeros(lv.z.shape, np.uint8)
