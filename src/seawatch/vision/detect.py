@@ -939,6 +939,9 @@ class _Candidate:
     peak: float  # peak z
     polarity: int = 3  # bits: 1 bright, 2 dark (3: both, or a colour contrast)
     maps: _Level | None = None  # its own finest-scale maps (censored windows), else None
+    # coarser candidates that gave way to it (:meth:`_resolve_scales`): refined in its
+    # place when neither it nor any other candidate they gave way to yields a ship
+    deferred: list[_Candidate] = field(default_factory=list)
 
 
 class _TemporalModel:
@@ -1007,8 +1010,9 @@ class ClassicalShipDetector:
        must reach ``z_peak > threshold · √(1 + ρ / clutter_rate)`` — a candidate that
        holds a shorter finer one that passed is tried again with the passed ones left
        out of its ring (a ship beside another is no clutter). A coarse candidate
-       narrow enough for the next finer scale gives way to the finer ones it overlaps; a
-       wider one replaces the finer ones inside it. Fragments of one ship (hull and
+       narrow enough for the next finer scale gives way to the finer ones it overlaps
+       (and is refined itself when none of them yields a ship in step 5); a wider one
+       replaces the finer ones inside it. Fragments of one ship (hull and
        superstructure) are merged when they overlap on one axis with a gap of at most
        ``merge_gap`` × the smaller height on the other; a bright and a dark one only
        when the bright one is stacked on the dark one (:meth:`_mergeable`).
@@ -1253,7 +1257,9 @@ class ClassicalShipDetector:
         cands = [c for c in cands if self._near_sea(c, fr, mask, ends, tol, 1.0)]
         out, polarity = [], []
         refine = self._refine if self.refine == "flank" else self._refine_mask
-        for c in cands:
+
+        def emit(c: _Candidate) -> bool:
+            """Refine candidate ``c`` and keep its ship-like objects on the sea."""
             lv = c.maps or levels[c.level]
             objects = refine(c, lv, fr)
             if objects and self.refine == "mask" and c.polarity == 1:
@@ -1261,7 +1267,8 @@ class ClassicalShipDetector:
                 # (:meth:`_refine`): a glitter streak is the sun path's structure
                 # running on beyond any window, a ship is not
                 if not self._refine(c, lv, fr):
-                    continue
+                    return False
+            n = len(out)
             for x, y, w, h, u, v, area in objects:
                 if (
                     min(w, h) < self.min_size
@@ -1276,6 +1283,20 @@ class ClassicalShipDetector:
                 score = 1.0 - math.exp(-0.5 * (c.peak / self.threshold) ** 2)
                 out.append((x, y, w, h, score, u, v))
                 polarity.append(c.polarity)
+            return len(out) > n
+
+        answered: dict[int, _Candidate] = {}  # deferred coarse candidates, by id
+        failed: dict[int, bool] = {}  # … whether every candidate they gave way to failed
+        for c in cands:
+            ok = emit(c)
+            for d in c.deferred:
+                answered[id(d)] = d
+                failed[id(d)] = failed.get(id(d), True) and not ok
+        # a coarse candidate whose finer ones yield no ship (a superstructure above the
+        # horizon, the hull lost at the finer scale) is refined itself
+        for key, d in answered.items():
+            if failed[key] and self._near_sea(d, fr, mask, ends, tol, 1.0):
+                emit(d)
         if not out:
             return Detections.empty()
         arr = np.array(out, dtype=np.float64)
@@ -1886,7 +1907,10 @@ class ClassicalShipDetector:
 
     def _resolve_scales(self, cands: list[_Candidate]) -> list[_Candidate]:
         """Coarse-to-fine arbitration: a coarse candidate narrow enough for the next finer
-        scale gives way to the finer candidates it overlaps; a wider one replaces the
+        scale gives way to the finer candidates it overlaps (each keeps it in its
+        ``deferred``: refined in their place when none of them yields a ship, a
+        superstructure above the horizon whose hull the finer scales lost); a wider one
+        replaces the
         finer candidates that lie (at least half) inside it — of a shared polarity only
         (a dark hull inside a wide bright glint path stays)."""
         if len({c.level for c in cands}) < 2:
@@ -1903,9 +1927,11 @@ class ClassicalShipDetector:
                 for j, c in enumerate(cands)
                 if alive[j] and c.level < ci.level and c.polarity & ci.polarity
             ]
-            if width <= capacity:
-                if any(_overlap(cands[j].box, ci.box) for j in finer):
-                    alive[i] = False
+            over = [j for j in finer if _overlap(cands[j].box, ci.box)]
+            if width <= capacity and over:
+                alive[i] = False
+                for j in over:
+                    cands[j].deferred.append(ci)
             else:
                 for j in finer:
                     if _frac_inside(cands[j].box, ci.box) >= 0.5:
@@ -1975,6 +2001,7 @@ class ClassicalShipDetector:
                             peak,
                             cands[i].polarity | cands[j].polarity,
                             cands[i].maps or cands[j].maps,
+                            cands[i].deferred + cands[j].deferred,
                         )
                         del cands[j]
                         changed = True
