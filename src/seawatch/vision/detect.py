@@ -772,6 +772,23 @@ def _clear_boxes(mask: NDArray, cands: list[_Candidate], f: int = 1, value: int 
         mask[max(0, y0) : y1 + 1, max(0, x0) : x1 + 1] = value
 
 
+def _peak_at(z: NDArray, box: NDArray, f: int) -> tuple[float, float]:
+    """Where in ``box`` (x0, y0, x1, y1 inclusive, working pixels) the map ``z`` of
+    scale ``f`` peaks: the peak pixel's centre (u, v) [working pixels]."""
+    x0, y0, x1, y1 = (int(b) // f for b in box)
+    win = z[max(0, y0) : y1 + 1, max(0, x0) : x1 + 1]
+    r, c = np.unravel_index(int(np.argmax(win)), win.shape)
+    return (max(0, x0) + c + 0.5) * f, (max(0, y0) + r + 0.5) * f
+
+
+def _holds(box: NDArray, u: float, v: float, slack: float) -> bool:
+    """Whether the point (u, v) lies in ``box`` (inclusive, working pixels), widened by
+    ``slack`` px on every side."""
+    return bool(
+        box[0] - slack <= u <= box[2] + 1 + slack and box[1] - slack <= v <= box[3] + 1 + slack
+    )
+
+
 def _area(box: NDArray) -> float:
     """Area of an inclusive box (x0, y0, x1, y1) [pixels]."""
     return float((box[2] - box[0] + 1) * (box[3] - box[1] + 1))
@@ -939,9 +956,6 @@ class _Candidate:
     peak: float  # peak z
     polarity: int = 3  # bits: 1 bright, 2 dark (3: both, or a colour contrast)
     maps: _Level | None = None  # its own finest-scale maps (censored windows), else None
-    # coarser candidates that gave way to it (:meth:`_resolve_scales`): refined in its
-    # place when neither it nor any other candidate they gave way to yields a ship
-    deferred: list[_Candidate] = field(default_factory=list)
 
 
 class _TemporalModel:
@@ -1011,11 +1025,10 @@ class ClassicalShipDetector:
        holds a shorter finer one that passed is tried again with the passed ones left
        out of its ring (a ship beside another is no clutter). A coarse candidate
        narrow enough for the next finer scale gives way to the finer ones it overlaps
-       (and is refined itself when none of them yields a ship in step 5); a wider one
-       replaces the finer ones inside it. Fragments of one ship (hull and
-       superstructure) are merged when they overlap on one axis with a gap of at most
-       ``merge_gap`` × the smaller height on the other; a bright and a dark one only
-       when the bright one is stacked on the dark one (:meth:`_mergeable`).
+       that hold its peak; a wider one replaces the finer ones inside it. Fragments of
+       one ship (hull and superstructure) are merged when they overlap on one axis with
+       a gap of at most ``merge_gap`` × the smaller height on the other; a bright and a
+       dark one only when the bright one is stacked on the dark one (:meth:`_mergeable`).
        With ``censor=True`` (the default) the targets the candidates hide are looked
        for too (:meth:`_censored`): around them the finest scale is computed again with
        their boxes left out of the training windows and noise cells, and components
@@ -1234,7 +1247,7 @@ class ClassicalShipDetector:
         hidden = []
         if self.censor and not self.temporal and cands:
             hidden = self._censored(every, cands, levels[0], floor)
-        cands = self._merge(self._resolve_scales(cands))
+        cands = self._merge(self._resolve_scales(cands, levels))
         if levels[0].blocks is not None:  # wide=True, not temporal (:meth:`_level`)
             wide = [
                 c
@@ -1257,9 +1270,7 @@ class ClassicalShipDetector:
         cands = [c for c in cands if self._near_sea(c, fr, mask, ends, tol, 1.0)]
         out, polarity = [], []
         refine = self._refine if self.refine == "flank" else self._refine_mask
-
-        def emit(c: _Candidate) -> bool:
-            """Refine candidate ``c`` and keep its ship-like objects on the sea."""
+        for c in cands:
             lv = c.maps or levels[c.level]
             objects = refine(c, lv, fr)
             if objects and self.refine == "mask" and c.polarity == 1:
@@ -1267,8 +1278,7 @@ class ClassicalShipDetector:
                 # (:meth:`_refine`): a glitter streak is the sun path's structure
                 # running on beyond any window, a ship is not
                 if not self._refine(c, lv, fr):
-                    return False
-            n = len(out)
+                    continue
             for x, y, w, h, u, v, area in objects:
                 if (
                     min(w, h) < self.min_size
@@ -1283,20 +1293,6 @@ class ClassicalShipDetector:
                 score = 1.0 - math.exp(-0.5 * (c.peak / self.threshold) ** 2)
                 out.append((x, y, w, h, score, u, v))
                 polarity.append(c.polarity)
-            return len(out) > n
-
-        answered: dict[int, _Candidate] = {}  # deferred coarse candidates, by id
-        failed: dict[int, bool] = {}  # … whether every candidate they gave way to failed
-        for c in cands:
-            ok = emit(c)
-            for d in c.deferred:
-                answered[id(d)] = d
-                failed[id(d)] = failed.get(id(d), True) and not ok
-        # a coarse candidate whose finer ones yield no ship (a superstructure above the
-        # horizon, the hull lost at the finer scale) is refined itself
-        for key, d in answered.items():
-            if failed[key] and self._near_sea(d, fr, mask, ends, tol, 1.0):
-                emit(d)
         if not out:
             return Detections.empty()
         arr = np.array(out, dtype=np.float64)
@@ -1905,13 +1901,12 @@ class ClassicalShipDetector:
         v = (y1 + 1) * fr.sy - 0.5
         return _in_sea(u, v, mask, ends, fr.shape, tol + heights * h)
 
-    def _resolve_scales(self, cands: list[_Candidate]) -> list[_Candidate]:
+    def _resolve_scales(self, cands: list[_Candidate], levels: list[_Level]) -> list[_Candidate]:
         """Coarse-to-fine arbitration: a coarse candidate narrow enough for the next finer
-        scale gives way to the finer candidates it overlaps (each keeps it in its
-        ``deferred``: refined in their place when none of them yields a ship, a
-        superstructure above the horizon whose hull the finer scales lost); a wider one
-        replaces the
-        finer candidates that lie (at least half) inside it — of a shared polarity only
+        scale gives way to the finer candidates it overlaps that hold its peak (a
+        fragment beside it — a superstructure whose hull the finer scales lost — does not
+        take its place); a wider one, or one whose peak no finer candidate holds,
+        replaces the finer candidates that lie (at least half) inside it — of a shared polarity only
         (a dark hull inside a wide bright glint path stays)."""
         if len({c.level for c in cands}) < 2:
             return cands
@@ -1928,10 +1923,12 @@ class ClassicalShipDetector:
                 if alive[j] and c.level < ci.level and c.polarity & ci.polarity
             ]
             over = [j for j in finer if _overlap(cands[j].box, ci.box)]
+            if over:  # those holding its peak
+                f = levels[ci.level].factor
+                u, v = _peak_at(levels[ci.level].z, ci.box, f)
+                over = [j for j in over if _holds(cands[j].box, u, v, f)]
             if width <= capacity and over:
                 alive[i] = False
-                for j in over:
-                    cands[j].deferred.append(ci)
             else:
                 for j in finer:
                     if _frac_inside(cands[j].box, ci.box) >= 0.5:
@@ -2001,7 +1998,6 @@ class ClassicalShipDetector:
                             peak,
                             cands[i].polarity | cands[j].polarity,
                             cands[i].maps or cands[j].maps,
-                            cands[i].deferred + cands[j].deferred,
                         )
                         del cands[j]
                         changed = True
