@@ -667,10 +667,13 @@ def _finite_quantile(cells: NDArray, n: NDArray, quantile: float) -> NDArray:
     return np.take_along_axis(np.sort(cells, axis=-1), k[..., None], axis=-1)[..., 0]
 
 
-def _window_hits(strong: NDArray[np.bool_], guard: int, flank: int) -> NDArray[np.bool_]:
-    """Where a pixel or one of its training windows (3 rows × ``flank`` columns,
-    ``guard`` columns beside it, as :func:`_contrast_kernel`'s) holds a ``strong`` pixel:
-    its ``|g − (L + R)/2|`` is a target's contrast, no noise sample."""
+def _window_counts(
+    strong: NDArray[np.bool_], guard: int, flank: int
+) -> tuple[NDArray, NDArray, NDArray]:
+    """Per pixel, the ``strong`` pixels in its 3-row column (``strong`` dilated by a row
+    up and down) and in its left and right training windows (3 rows × ``flank``
+    columns, ``guard`` columns beside it, as :func:`_contrast_kernel`'s; cut at the
+    image's edges)."""
     s = cv2.dilate(strong.view(np.uint8), np.ones((3, 1), np.uint8))
     h, w = s.shape
     cs = np.zeros((h, w + 1), np.int32)
@@ -678,28 +681,27 @@ def _window_hits(strong: NDArray[np.bool_], guard: int, flank: int) -> NDArray[n
     j = np.arange(w)
     left = cs[:, np.clip(j - guard, 0, w)] - cs[:, np.clip(j - guard - flank, 0, w)]
     right = cs[:, np.clip(j + guard + flank + 1, 0, w)] - cs[:, np.clip(j + guard + 1, 0, w)]
+    return s, left, right
+
+
+def _window_hits(strong: NDArray[np.bool_], guard: int, flank: int) -> NDArray[np.bool_]:
+    """Where a pixel or one of its training windows (:func:`_window_counts`) holds a
+    ``strong`` pixel: its ``|g − (L + R)/2|`` is a target's contrast, no noise sample."""
+    s, left, right = _window_counts(strong, guard, flank)
     return (left > 0) | (right > 0) | (s > 0)
 
 
 def _one_sided_hits(strong: NDArray[np.bool_], guard: int, flank: int) -> NDArray[np.bool_]:
     """The pixels within ``guard + flank`` columns of the left or right edge, where the
     contrast kernels have one training window (:func:`_contrast_kernel`), whose window
-    holds a ``strong`` pixel: there a target in it makes its own sea beside it look like a
-    target of the other polarity."""
-    s = cv2.dilate(strong.view(np.uint8), np.ones((3, 1), np.uint8))
-    h, w = s.shape
-    out = np.zeros((h, w), bool)
+    (:func:`_window_counts`) holds a ``strong`` pixel: there a target in it makes its own
+    sea beside it look like a target of the other polarity."""
+    _, left, right = _window_counts(strong, guard, flank)
+    w = strong.shape[1]
     edge = min(guard + flank, w)
-    if edge == 0:
-        return out
-    cs = np.zeros((h, w + 1), np.int32)
-    np.cumsum(s, axis=1, out=cs[:, 1:])
-    j = np.arange(edge)  # left edge: the right window, columns j + guard + 1 …
-    a, b = np.clip(j + guard + 1, 0, w), np.clip(j + guard + 1 + flank, 0, w)
-    out[:, :edge] = cs[:, b] > cs[:, a]
-    j = np.arange(w - edge, w)  # right edge: the left window, … columns j − guard − 1
-    a, b = np.clip(j - guard - flank, 0, w), np.clip(j - guard, 0, w)
-    out[:, w - edge :] |= cs[:, b] > cs[:, a]
+    out = np.zeros(strong.shape, bool)
+    out[:, :edge] = right[:, :edge] > 0  # left edge: the right window
+    out[:, w - edge :] |= left[:, w - edge :] > 0  # right edge: the left window
     return out
 
 
