@@ -714,11 +714,16 @@ def _wide_blocks(
     ``|d|``, which a target filling up to two thirds of the width leaves unmoved) or the
     local detail ``tex``, where larger [units of ``d``]."""
     row = _cell_noise(d, cell_h, d.shape[1], floor, step=2, quantile=0.3)
-    hot = (c > threshold * np.maximum(row, tex)).astype(np.float32)
-    hb, wb = d.shape[0] // 9, d.shape[1] // 9
+    return _strong_blocks((c > threshold * np.maximum(row, tex)).astype(np.float32), 9)
+
+
+def _strong_blocks(hot: NDArray, size: int) -> NDArray[np.bool_]:
+    """The ``size × size`` blocks (whole ones, from the top-left corner) of the 0/1 map
+    ``hot`` (float32) in which at least ``_STRONG_SHARE`` of the pixels are 1."""
+    hb, wb = hot.shape[0] // size, hot.shape[1] // size
     if hb == 0 or wb == 0:
-        return np.zeros((0, 0), bool)
-    share = cv2.resize(hot[: hb * 9, : wb * 9], (wb, hb), interpolation=cv2.INTER_AREA)
+        return np.zeros((hb, wb), bool)
+    share = cv2.resize(hot[: hb * size, : wb * size], (wb, hb), interpolation=cv2.INTER_AREA)
     return share >= _STRONG_SHARE
 
 
@@ -1404,10 +1409,8 @@ class ClassicalShipDetector:
             else:
                 g = cv2.resize(band[: hk * f, : wk * f], (wk, hk), interpolation=cv2.INTER_AREA)
                 if k >= 2:  # the finest scale's targets, by level pixel
-                    z0 = out[0].z[: hk * f, : wk * f]
-                    hot = cv2.threshold(z0, self.threshold, 1.0, cv2.THRESH_BINARY)[1]
-                    share = cv2.resize(hot, (wk, hk), interpolation=cv2.INTER_AREA)
-                    strong = share >= _STRONG_SHARE
+                    hot = cv2.threshold(out[0].z, self.threshold, 1.0, cv2.THRESH_BINARY)[1]
+                    strong = _strong_blocks(hot, f)
             out.append(self._level(g, f, floor / f, guard, flank, fr, strong))
         return out
 
