@@ -771,9 +771,9 @@ def _in_sea(
     return True
 
 
-def _clear_boxes(mask: NDArray, cands: list[_Candidate], f: int = 1, value: int = 0) -> None:
-    """Set ``mask`` (a map at scale ``f``) to ``value`` over the candidates' inclusive
-    boxes (working pixels), in place."""
+def _paint_boxes(mask: NDArray, cands: list[_Candidate], f: int = 1, value: int = 0) -> None:
+    """Set ``mask`` (a map at scale ``f``) to ``value`` (default 0: cleared) over the
+    candidates' inclusive boxes (working pixels), in place."""
     for c in cands:
         x0, y0, x1, y1 = (int(v) // f for v in c.box)
         mask[max(0, y0) : y1 + 1, max(0, x0) : x1 + 1] = value
@@ -1770,7 +1770,7 @@ class ClassicalShipDetector:
                 & (peaks > _WIDE_FACTOR * self.threshold)
             )
             grow = (lw.z > self.grow_threshold).view(np.uint8).copy()
-            _clear_boxes(grow, cands, f)  # targets that passed are no clutter
+            _paint_boxes(grow, cands, f)  # targets that passed are no clutter
             for i in np.flatnonzero(ok):
                 x0, y0, x1, y1 = boxes[i]
                 ring = grow.copy()
@@ -1800,7 +1800,7 @@ class ClassicalShipDetector:
         lv = c.maps
         f, (guard, flank) = lv.factor, lv.window
         held = np.zeros(lv.z.shape, np.uint8)
-        _clear_boxes(held, [t for t in targets if not t.polarity & c.polarity], f, 1)
+        _paint_boxes(held, [t for t in targets if not t.polarity & c.polarity], f, 1)
         if not held.any():
             return False
         x0, y0, x1, y1 = (int(v) // f for v in c.box)
@@ -1863,7 +1863,7 @@ class ClassicalShipDetector:
             if not failed or not clear:
                 continue
             masked = grow.copy()
-            _clear_boxes(masked, clear)
+            _paint_boxes(masked, clear)
             ii_clear = cv2.integral(masked)
             for i in failed:
                 passed[i] = self._clutter_pass(cands[i], ii_clear, grow.shape)
